@@ -1,0 +1,2 @@
+//! The `raypath` command-line program.
+fn main() {}

@@ -1,0 +1,1 @@
+//! Organized range images (placeholder, being written).

@@ -1,0 +1,1 @@
+//! Proptest strategies (placeholder, being written).

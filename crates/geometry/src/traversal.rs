@@ -1,0 +1,1 @@
+//! Amanatides–Woo traversal (placeholder, being written).
