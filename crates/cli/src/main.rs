@@ -1,2 +1,45 @@
-//! The `raypath` command-line program.
-fn main() {}
+//! `raypath`: every raypath capability on your own files.
+//!
+//! ```text
+//! raypath info <path> [--json] [--format <name>]
+//! ```
+//!
+//! Every subcommand prints a human-readable report, or with `--json` one JSON document on
+//! standard output for scripts. Errors go to standard error as `error: <file>:<place>: <reason>`
+//! (and, with `--json`, as `{"error": "..."}` on standard output); the exit code is 2 for bad
+//! input and 1 for other failures.
+
+mod commands;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(
+    name = "raypath",
+    version,
+    about = "Lidar mapping, localization and place recognition on your own data"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Detect a file's format and summarize it: scans, beams, points, poses, odometry,
+    /// organized size, labels, bounding box, time span. A KITTI or NCLT directory is one input.
+    Info(commands::info::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Info(args) => commands::info::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(failure) => failure.report(),
+    }
+}

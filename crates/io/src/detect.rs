@@ -56,6 +56,35 @@ pub enum Format {
 }
 
 impl Format {
+    /// Every format, in documentation order.
+    pub const ALL: [Format; 20] = [
+        Format::Carmen,
+        Format::Pcd,
+        Format::Xyz,
+        Format::OctomapBt,
+        Format::OctomapGraph,
+        Format::KittiSequence,
+        Format::KittiVelodyne,
+        Format::KittiPoses,
+        Format::KittiTimes,
+        Format::KittiCalib,
+        Format::NcltSession,
+        Format::NcltVelodyneSync,
+        Format::NcltVelodyneHits,
+        Format::NcltGroundTruth,
+        Format::NcltOdometry,
+        Format::NcltCovariance,
+        Format::SegcompRange,
+        Format::SegcompGtSeg,
+        Format::SegcompGtAng,
+        Format::PointCsv,
+    ];
+
+    /// The format with this [`Format::name`].
+    pub fn from_name(name: &str) -> Option<Format> {
+        Format::ALL.into_iter().find(|f| f.name() == name)
+    }
+
     /// The name printed by `raypath info` and used as the JSON `format` value.
     pub fn name(self) -> &'static str {
         match self {
@@ -320,6 +349,13 @@ fn numeric_columns(text: &str) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        for format in Format::ALL {
+            assert_eq!(Format::from_name(format.name()), Some(format));
+        }
+    }
 
     #[test]
     fn recognizes_segcomp_names() {

@@ -1,0 +1,123 @@
+//! `raypath info`: what a file holds.
+
+use std::path::PathBuf;
+
+use raypath_io::{Format, Summary};
+
+use super::Failure;
+
+/// Arguments of `raypath info`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A file (CARMEN log, PCD, OctoMap .bt/.graph, xyz text, KITTI/NCLT file, SegComp file,
+    /// point CSV; plain, .gz or .bz2) or a KITTI sequence / NCLT session directory.
+    pub path: PathBuf,
+    /// Print one JSON object (keys: format, scans, beams, points, poses, odometry, width,
+    /// height, labels, bbox, time_span, nodes, and format-specific entries).
+    #[arg(long)]
+    pub json: bool,
+    /// Read the input as this format instead of detecting it (for example `carmen`, `pcd`,
+    /// `xyz`, `octomap-bt`, `kitti`, `nclt`).
+    #[arg(long, value_name = "NAME")]
+    pub format: Option<String>,
+}
+
+/// Runs `raypath info`.
+pub fn run(args: &Args) -> Result<(), Failure> {
+    let format = match &args.format {
+        Some(name) => Format::from_name(name).ok_or_else(|| {
+            let names: Vec<_> = Format::ALL.iter().map(|f| f.name()).collect();
+            Failure::input(
+                format!(
+                    "unknown format {name:?}; choose one of {}",
+                    names.join(", ")
+                ),
+                args.json,
+            )
+        })?,
+        None => Format::detect(&args.path).map_err(|e| Failure::input(e, args.json))?,
+    };
+    let summary =
+        raypath_io::summarize_as(&args.path, format).map_err(|e| Failure::input(e, args.json))?;
+    if args.json {
+        let text = serde_json::to_string_pretty(&summary).map_err(|e| Failure {
+            message: e.to_string(),
+            bad_input: false,
+            json: false,
+        })?;
+        println!("{text}");
+    } else {
+        print!("{}", render_text(&args.path, &summary));
+    }
+    Ok(())
+}
+
+/// The human-readable report: one `key: value` line per field that applies.
+pub fn render_text(path: &std::path::Path, s: &Summary) -> String {
+    let mut lines = vec![(String::from("file"), path.display().to_string())];
+    let mut push = |key: &str, value: String| lines.push((key.to_owned(), value));
+    push("format", s.format.clone());
+    if let Some(v) = s.scans {
+        push("scans", v.to_string());
+    }
+    if let Some(v) = s.beams {
+        let range = match (s.beams_min, s.beams_max) {
+            (Some(lo), Some(hi)) => format!(" (most common; {lo} to {hi})"),
+            _ => String::new(),
+        };
+        push("beams", format!("{v}{range}"));
+    }
+    for (key, value) in [
+        ("points", s.points),
+        ("poses", s.poses),
+        ("odometry", s.odometry),
+        ("nodes", s.nodes),
+    ] {
+        if let Some(v) = value {
+            push(key, v.to_string());
+        }
+    }
+    if let (Some(w), Some(h)) = (s.width, s.height) {
+        push("size", format!("{w} × {h} (width × height)"));
+    }
+    if let Some(labels) = &s.labels {
+        let shown: Vec<_> = labels.iter().take(20).map(u32::to_string).collect();
+        let more = if labels.len() > 20 { ", …" } else { "" };
+        push(
+            "labels",
+            format!("{} distinct: {}{more}", labels.len(), shown.join(", ")),
+        );
+    }
+    if let Some(b) = &s.bbox {
+        push(
+            "bbox",
+            format!(
+                "[{:.3}, {:.3}, {:.3}] to [{:.3}, {:.3}, {:.3}] m",
+                b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]
+            ),
+        );
+    }
+    if let Some(t) = &s.time_span {
+        push(
+            "time span",
+            format!("{:.6} to {:.6} s ({:.3} s)", t.start, t.end, t.duration),
+        );
+    }
+    for (key, value) in &s.extra {
+        let text = match value {
+            serde_json::Value::String(text) => text.clone(),
+            other => other.to_string(),
+        };
+        push(&key.replace('_', " "), text);
+    }
+    let width = lines
+        .iter()
+        .map(|(k, _)| k.chars().count())
+        .max()
+        .unwrap_or(0)
+        + 1;
+    lines
+        .iter()
+        .map(|(k, v)| format!("{:<width$}  {v}\n", format!("{k}:")))
+        .collect()
+}

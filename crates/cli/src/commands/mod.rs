@@ -1,0 +1,35 @@
+//! One module per subcommand, plus the shared failure type.
+
+pub mod info;
+
+use std::process::ExitCode;
+
+/// Why a subcommand failed, and how to report it.
+pub struct Failure {
+    /// The message (for input errors: `file:place: reason`).
+    pub message: String,
+    /// True for bad input (exit code 2), false for other failures (exit code 1).
+    pub bad_input: bool,
+    /// Also print `{"error": message}` on standard output.
+    pub json: bool,
+}
+
+impl Failure {
+    /// A failure caused by the user's input.
+    pub fn input(error: impl std::fmt::Display, json: bool) -> Self {
+        Self {
+            message: error.to_string(),
+            bad_input: true,
+            json,
+        }
+    }
+
+    /// Prints the failure and returns the exit code.
+    pub fn report(&self) -> ExitCode {
+        eprintln!("error: {}", self.message);
+        if self.json {
+            println!("{}", serde_json::json!({ "error": self.message }));
+        }
+        ExitCode::from(if self.bad_input { 2 } else { 1 })
+    }
+}

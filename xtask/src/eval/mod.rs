@@ -1,0 +1,243 @@
+//! The evaluation registry and the report writer shared by all evaluations.
+//!
+//! Every evaluation is a function `run(&EvalContext) -> Result<EvalReport>`. The framework
+//! prints the report, writes `docs/results/<name>.md` (with the command, date, machine and
+//! data directory) and `target/eval/<name>.json`.
+
+mod carmen_angles;
+mod geometry;
+mod io;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+
+/// What an evaluation gets: where things are and how much work to do.
+pub struct EvalContext {
+    /// The workspace root (where `Cargo.toml` and `docs/` are).
+    pub workspace_root: PathBuf,
+    /// The data directory (`RAYPATH_DATA`, default `datasets/`).
+    pub data_dir: PathBuf,
+    /// Smaller workloads for CI and first runs.
+    pub quick: bool,
+}
+
+impl EvalContext {
+    /// A progress bar for `len` steps, drawn on stderr (hidden when stderr is not a terminal).
+    pub fn progress(&self, len: u64, message: &str) -> ProgressBar {
+        let bar = ProgressBar::new(len);
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{msg:>14} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta})",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+        );
+        bar.set_message(message.to_owned());
+        bar
+    }
+
+    /// Path of a data file, relative to the data directory.
+    pub fn data(&self, relative: &str) -> PathBuf {
+        self.data_dir.join(relative)
+    }
+
+    /// Where an evaluation may write pictures that belong to its report
+    /// (`docs/results/<name>/`), created on demand.
+    pub fn figure_dir(&self, name: &str) -> Result<PathBuf> {
+        let dir = self.workspace_root.join("docs/results").join(name);
+        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        Ok(dir)
+    }
+}
+
+/// The result of one evaluation.
+pub struct EvalReport {
+    /// Short name (`io`, `geometry`, …): file names and `cargo xtask eval <name>`.
+    pub name: &'static str,
+    /// A one-line title.
+    pub title: String,
+    /// The markdown body: tables beside the thesis figures, notes on what is real and what is
+    /// simulated.
+    pub markdown: String,
+    /// Machine-readable results.
+    pub json: serde_json::Value,
+}
+
+type EvalFn = fn(&EvalContext) -> Result<EvalReport>;
+
+/// All evaluations in the order `all` runs them.
+const EVALUATIONS: &[(&str, &str, EvalFn)] = &[
+    (
+        "io",
+        "read every file under RAYPATH_DATA: counts and throughput per format",
+        io::run,
+    ),
+    (
+        "geometry",
+        "exact ray traversal throughput in 2-D and 3-D (cells per second)",
+        geometry::run,
+    ),
+    (
+        "carmen-angles",
+        "CARMEN beam-angle convention checked by map sharpness on the corrected logs",
+        carmen_angles::run,
+    ),
+];
+
+/// Runs `name` (or `all`, or `list`).
+pub fn run(name: &str, quick: bool) -> Result<()> {
+    if name == "list" {
+        for (name, about, _) in EVALUATIONS {
+            println!("{name:<16} {about}");
+        }
+        return Ok(());
+    }
+    let ctx = EvalContext {
+        workspace_root: workspace_root(),
+        data_dir: data_dir(),
+        quick,
+    };
+    let selected: Vec<_> = if name == "all" {
+        EVALUATIONS.iter().collect()
+    } else {
+        let found: Vec<_> = EVALUATIONS.iter().filter(|(n, _, _)| *n == name).collect();
+        if found.is_empty() {
+            let names: Vec<_> = EVALUATIONS.iter().map(|(n, _, _)| *n).collect();
+            bail!(
+                "no evaluation named {name:?}; choose one of {} or all",
+                names.join(", ")
+            );
+        }
+        found
+    };
+    let mut failures = Vec::new();
+    for (name, _, eval) in selected {
+        eprintln!("== eval {name}{}", if quick { " (quick)" } else { "" });
+        let started = Instant::now();
+        match eval(&ctx) {
+            Ok(report) => write_report(&ctx, &report, started.elapsed().as_secs_f64())?,
+            Err(error) => {
+                eprintln!("eval {name} failed: {error:#}");
+                failures.push(*name);
+            }
+        }
+    }
+    if !failures.is_empty() {
+        bail!("evaluations failed: {}", failures.join(", "));
+    }
+    Ok(())
+}
+
+fn write_report(ctx: &EvalContext, report: &EvalReport, seconds: f64) -> Result<()> {
+    let command = format!(
+        "cargo xtask eval {}{}",
+        report.name,
+        if ctx.quick { " --quick" } else { "" }
+    );
+    let header = format!(
+        "# {}\n\n<!-- Written by `{command}`; do not edit by hand. -->\n\n\
+         - Command: `{command}`\n- Date (UTC): {}\n- Machine: {}\n- Data: `{}`\n- Run time: {seconds:.1} s\n\n",
+        report.title,
+        utc_date(),
+        machine(),
+        ctx.data_dir.display(),
+    );
+    let markdown = format!("{header}{}", report.markdown.trim_end());
+    println!("{markdown}\n");
+
+    let docs = ctx.workspace_root.join("docs/results");
+    std::fs::create_dir_all(&docs)?;
+    let md_path = docs.join(format!("{}.md", report.name));
+    std::fs::write(&md_path, format!("{markdown}\n"))
+        .with_context(|| format!("writing {}", md_path.display()))?;
+
+    let json_dir = ctx.workspace_root.join("target/eval");
+    std::fs::create_dir_all(&json_dir)?;
+    let json_path = json_dir.join(format!("{}.json", report.name));
+    let json = serde_json::json!({
+        "name": report.name,
+        "title": report.title,
+        "command": command,
+        "quick": ctx.quick,
+        "date_utc": utc_date(),
+        "machine": machine(),
+        "data_dir": ctx.data_dir.display().to_string(),
+        "seconds": seconds,
+        "results": report.json,
+    });
+    std::fs::write(&json_path, serde_json::to_string_pretty(&json)?)
+        .with_context(|| format!("writing {}", json_path.display()))?;
+    eprintln!("wrote {} and {}", md_path.display(), json_path.display());
+    Ok(())
+}
+
+/// The workspace root: the parent of the xtask crate.
+pub fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("."))
+}
+
+/// `RAYPATH_DATA`, or `datasets/` in the workspace.
+pub fn data_dir() -> PathBuf {
+    match std::env::var_os("RAYPATH_DATA") {
+        Some(dir) if !dir.is_empty() => {
+            let dir = PathBuf::from(dir);
+            std::fs::canonicalize(&dir).unwrap_or(dir)
+        }
+        _ => workspace_root().join("datasets"),
+    }
+}
+
+/// CPU model and core count, for report headers.
+pub fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|info| {
+            info.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_owned())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_owned());
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    format!("{cpu}, {cores} cores available")
+}
+
+/// Today's date in UTC as `YYYY-MM-DD HH:MM`.
+pub fn utc_date() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let days = (secs / 86_400) as i64;
+    let (hour, minute) = ((secs % 86_400) / 3600, (secs % 3600) / 60);
+    // Civil-from-days (Howard Hinnant's algorithm).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!("{year:04}-{month:02}-{day:02} {hour:02}:{minute:02}")
+}
+
+/// Median of a slice (sorted in place); NaN for none.
+pub fn median(values: &mut [f64]) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    }
+}
