@@ -1,0 +1,116 @@
+//! The Perceptron scanner geometry: from a range-image pixel to a 3-D point (`sc2cart`).
+
+use nalgebra::{Point3, Vector3};
+
+/// The constants of the SegComp Perceptron range-to-Cartesian conversion.
+///
+/// Source: `range-to-coords.c` of the USF segmentation-comparison distribution (Hoover et al.
+/// 1996), as used by the PPE reference implementation (`sc2cart`; spec
+/// `schaefer-2020-features.md` §5.2). For pixel (row `r`, column `c`) of an `nr × nc` image
+/// with raw range `ra` (12-bit counts):
+///
+/// ```text
+/// α = α0 + H·(255.5 − c)/nc,   β = β0 + V·(255.5 − r)/nr        (degrees → radians)
+/// dz = −h1·(1 − cos α)/tan γ,   dy = dz·tan(θ + β/2),   dx = (h2 + dy)·tan α
+/// r1 = (dz − h2)/δ,   r2 = √(dx² + (h2 + dy)²)/δ,   r3 = (ra + r0 − (r1 + r2))·δ
+/// X = dx + r3·sin α,   Y = dy + r3·cos α·sin β,   Z = dz + r3·cos α·cos β
+/// ```
+///
+/// `(X, Y, Z)` is the scanner frame of the original code — X to the left as seen from the
+/// scanner (α > 0), Y up (β > 0), Z out of the scanner — in the file's length unit, which the
+/// reference implementation takes as millimetres ([`PerceptronGeometry::unit_m`] = 0.001). The
+/// original C code divides by the nominal 512 instead of `nc`/`nr`; for the 512 × 512 SegComp
+/// images this is the same. (A ROS port of the code scales by 1/100 instead, i.e. reads
+/// centimetres: the unit is an assumption of the benchmark users, not part of the files.)
+///
+/// The laser leaves the scanner at `(dx, dy, dz)`, not at the origin; like the reference
+/// implementation, raypath treats the points as seen from the origin of the sensor frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PerceptronGeometry {
+    /// Distance between the rotating-mirror axis and the laser beam, `h1`.
+    pub h1: f64,
+    /// Distance between the nodding-mirror axis and the rotating-mirror intersection, `h2`.
+    pub h2: f64,
+    /// Slope of the rotating mirror, `γ`, degrees.
+    pub gamma_deg: f64,
+    /// Slope of the nodding mirror in mid position, `θ`, degrees.
+    pub theta_deg: f64,
+    /// Horizontal angle offset `α0`, degrees.
+    pub alpha0_deg: f64,
+    /// Vertical angle offset `β0`, degrees.
+    pub beta0_deg: f64,
+    /// Horizontal field of view `H`, degrees.
+    pub horizontal_fov_deg: f64,
+    /// Vertical field of view `V`, degrees.
+    pub vertical_fov_deg: f64,
+    /// Stand-off distance `r0` (range counts).
+    pub r0: f64,
+    /// Length per range count, `δ`.
+    pub delta: f64,
+    /// Metres per unit of `X, Y, Z` (0.001: millimetres).
+    pub unit_m: f64,
+}
+
+impl Default for PerceptronGeometry {
+    fn default() -> Self {
+        Self {
+            h1: 3.0,
+            h2: 5.5,
+            gamma_deg: 45.0,
+            theta_deg: 45.0,
+            alpha0_deg: 0.0,
+            beta0_deg: 0.0,
+            horizontal_fov_deg: 51.65,
+            vertical_fov_deg: 36.73,
+            r0: 830.3,
+            delta: 0.20236,
+            unit_m: 1e-3,
+        }
+    }
+}
+
+impl PerceptronGeometry {
+    /// `sc2cart`: the scanner-frame coordinates `(X, Y, Z)` of pixel `(row, col)` of a
+    /// `rows × cols` image with raw range `range`, in the file's unit (see the type docs).
+    pub fn scanner_xyz(
+        &self,
+        row: usize,
+        col: usize,
+        rows: usize,
+        cols: usize,
+        range: f64,
+    ) -> Vector3<f64> {
+        let alpha = (self.alpha0_deg
+            + self.horizontal_fov_deg * (255.5 - col as f64) / cols as f64)
+            .to_radians();
+        let beta = (self.beta0_deg + self.vertical_fov_deg * (255.5 - row as f64) / rows as f64)
+            .to_radians();
+        let gamma = self.gamma_deg.to_radians();
+        let theta = self.theta_deg.to_radians();
+        let dz = -self.h1 * (1.0 - alpha.cos()) / gamma.tan();
+        let dy = dz * (theta + 0.5 * beta).tan();
+        let dx = (self.h2 + dy) * alpha.tan();
+        let r1 = (dz - self.h2) / self.delta;
+        let r2 = (dx * dx + (self.h2 + dy) * (self.h2 + dy)).sqrt() / self.delta;
+        let r3 = (range + self.r0 - (r1 + r2)) * self.delta;
+        Vector3::new(
+            dx + r3 * alpha.sin(),
+            dy + r3 * alpha.cos() * beta.sin(),
+            dz + r3 * alpha.cos() * beta.cos(),
+        )
+    }
+
+    /// The point of pixel `(row, col)` in the REP-103 sensor frame (x forward = Z, y left = X,
+    /// z up = Y), in metres.
+    pub fn point(
+        &self,
+        row: usize,
+        col: usize,
+        rows: usize,
+        cols: usize,
+        range: f64,
+    ) -> Point3<f64> {
+        let s = self.scanner_xyz(row, col, rows, cols, range);
+        Point3::new(s.z, s.x, s.y) * self.unit_m
+    }
+}
