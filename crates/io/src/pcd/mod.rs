@@ -48,6 +48,8 @@
 //! # Ok::<(), raypath_io::Error>(())
 //! ```
 
+mod binary;
+mod fields;
 mod header;
 pub mod lzf;
 mod read;
