@@ -30,10 +30,12 @@
 //! **Beam angles.** `ROBOTLASER1` lines state the first angle and the increment. `FLASER`
 //! and `RLASER` lines do not: beam 0 points to the robot's right (−90°) and the fan spans
 //! the field of view (π unless `PARAM laser_front_laser_fov` says otherwise) by the
-//! [`FanConvention`] of [`CarmenConfig`]. The default, [`FanConvention::Closed`]
-//! (`linspace(−fov/2, fov/2, n)`), was chosen empirically: rendered with the reference poses,
-//! it gives the sharpest maps for every corrected Radish log, whether the scans have 180,
-//! 181, 360 or 361 beams (`cargo xtask eval carmen-angles`, `docs/results/carmen-angles.md`).
+//! [`FanConvention`] of [`CarmenConfig`]. The default, [`FanConvention::Auto`], puts beam `i`
+//! at −90° + i·180°/(n − n mod 2): 1° steps for 180 and 181 beams, 0.5° for 360 and 361, the
+//! last beam at +89°/+89.5° for even counts and +90° for odd ones. It was chosen
+//! empirically: rendered with the reference poses, it gives the sharpest maps of all ten
+//! corrected Radish logs (fewest occupied 5 cm cells; `cargo xtask eval carmen-angles`,
+//! report in `docs/results/carmen-angles.md`).
 //! A `PARAM laser_front_laser_resolution` line (degrees) sets the increment.
 //!
 //! **No-returns.** Readings at or above [`raypath_geometry::Scan2::max_range_m`] are
