@@ -29,9 +29,9 @@ use crate::source::LineReader;
 /// # Ok::<(), raypath_io::Error>(())
 /// ```
 ///
-/// Each item is one message line. A malformed line gives an `Err` naming the line and the
-/// field, and reading goes on with the next line; a read error of the file (a damaged gzip
-/// stream, for example) ends the iteration after its `Err`.
+/// Each item is one message line. A malformed line (or one that is not UTF-8) gives an `Err`
+/// naming the line and the field, and reading goes on with the next line; a read error of
+/// the file (a damaged gzip stream, for example) ends the iteration after its `Err`.
 pub struct CarmenReader {
     name: PathBuf,
     lines: LineReader,
@@ -41,6 +41,9 @@ pub struct CarmenReader {
     pending: VecDeque<(u64, Result<Parsed>)>,
     done: bool,
 }
+
+/// The look-ahead also stops after this many kept lines per laser message it may read.
+const LOOKAHEAD_LINES_PER_SCAN: usize = 100;
 
 /// What the first pass (or the look-ahead) learns: range histograms and laser parameters.
 #[derive(Default)]
@@ -108,8 +111,9 @@ impl CarmenReader {
     }
 
     /// Reads a log from `reader` with `config`. With [`NoReturnRange::Infer`] the first
-    /// [`CarmenConfig::lookahead_scans`] laser messages (and the lines between them) are read
-    /// and kept now to infer the no-return code.
+    /// [`CarmenConfig::lookahead_scans`] laser messages (and the lines between them, at most
+    /// 100 lines per look-ahead scan in all) are read and kept now to infer the no-return
+    /// code.
     pub fn with_config(
         name: impl Into<PathBuf>,
         reader: impl BufRead + Send + 'static,
@@ -129,7 +133,14 @@ impl CarmenReader {
         let mut pending = VecDeque::new();
         let mut done = false;
         let mut scans = 0;
-        while config.no_return == NoReturnRange::Infer && scans < config.lookahead_scans {
+        // Bounded in lines too, so a log without laser messages is not read into memory.
+        let max_lines = config
+            .lookahead_scans
+            .saturating_mul(LOOKAHEAD_LINES_PER_SCAN);
+        while config.no_return == NoReturnRange::Infer
+            && scans < config.lookahead_scans
+            && pending.len() < max_lines
+        {
             let line = lines.line_number() + 1;
             let parsed = match lines.next_line() {
                 Ok(Some(text)) => parse_line(text, &name, line),
@@ -138,9 +149,14 @@ impl CarmenReader {
                     break;
                 }
                 Err(e) => {
+                    // A line that is not UTF-8 is skipped; a read error ends the stream.
+                    let fatal = matches!(e, Error::Io { .. });
                     pending.push_back((line, Err(e)));
-                    done = true;
-                    break;
+                    if fatal {
+                        done = true;
+                        break;
+                    }
+                    continue;
                 }
             };
             match parsed {
@@ -292,7 +308,7 @@ impl Iterator for CarmenReader {
                             return None;
                         }
                         Err(e) => {
-                            self.done = true;
+                            self.done = matches!(e, Error::Io { .. });
                             return Some(Err(e));
                         }
                     }
