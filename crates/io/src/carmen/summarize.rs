@@ -18,7 +18,11 @@ use crate::summary::{BoundingBox, Summary, TimeSpan};
 /// * `poses`: laser messages with a pose (all of them: every laser line carries one);
 /// * `odometry`: `ODOM` lines only (the odometry poses inside laser lines are not counted,
 ///   so a log like mit-csail, whose odometry lives only in its `FLASER` lines, reports 0);
-/// * `time_span`: over the IPC timestamps of laser and odometry messages;
+/// * `time_span`: over the IPC timestamps of the laser messages (of the `ODOM` messages in a
+///   log without laser messages). The `ODOM` lines of the corrected Radish logs carry
+///   timestamps unrelated to the scans (zeros, UNIX times), so they are left out. The data
+///   are what they are: freiburg-campus's scans are all stamped 0, and infinite-corridor's
+///   last scans 4 294 967 296 s (2³², an overflow in the original conversion);
 /// * `bbox`: of the world-frame hit points (laser poses, z = 0);
 /// * extras: `no_return_range_m` (the no-return threshold of the last scan of the most
 ///   common laser kind),
@@ -33,7 +37,7 @@ pub fn summarize(path: &Path) -> Result<Summary> {
     let mut kinds: BTreeMap<LaserKind, (u64, f64)> = BTreeMap::new();
     let mut messages: BTreeMap<String, u64> = BTreeMap::new();
     let mut bbox = Aabb3::empty();
-    let mut time_span = None;
+    let (mut time_span, mut odometry_span) = (None, None);
     let (mut scans, mut odometry, mut params) = (0u64, 0u64, 0u64);
     let mut estimates = Vec::new();
     for kind in [LaserKind::Front, LaserKind::Rear, LaserKind::RobotLaser1] {
@@ -54,7 +58,7 @@ pub fn summarize(path: &Path) -> Result<Summary> {
             }
             Record::Odometry(odom) => {
                 odometry += 1;
-                TimeSpan::extend(&mut time_span, odom.ipc_timestamp_secs);
+                TimeSpan::extend(&mut odometry_span, odom.ipc_timestamp_secs);
                 "ODOM".to_owned()
             }
             Record::Param { .. } => {
@@ -69,7 +73,7 @@ pub fn summarize(path: &Path) -> Result<Summary> {
     summary.set_beams_from_counts(&beams);
     summary.poses = Some(scans);
     summary.odometry = Some(odometry);
-    summary.time_span = time_span;
+    summary.time_span = time_span.or(odometry_span);
     summary.bbox = BoundingBox::from_aabb(&bbox);
     // The most common laser kind speaks for the log.
     if let Some((&main_kind, &(_, range_m))) = kinds.iter().max_by_key(|&(_, (n, _))| *n) {
