@@ -35,7 +35,7 @@ impl Scan2 {
                 reason: "beam angles must be finite".into(),
             });
         }
-        if !(self.max_range_m > 0.0) {
+        if self.max_range_m.is_nan() || self.max_range_m <= 0.0 {
             return Err(GeometryError::InvalidScan {
                 reason: format!("maximum range must be positive, got {}", self.max_range_m),
             });
