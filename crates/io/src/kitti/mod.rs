@@ -1,0 +1,126 @@
+//! KITTI odometry benchmark files: velodyne scans, poses, timestamps and calibration.
+//!
+//! The layout is the one of the KITTI odometry benchmark (Geiger et al., "Are we ready for
+//! autonomous driving? The KITTI vision benchmark suite", CVPR 2012;
+//! <https://www.cvlibs.net/datasets/kitti/eval_odometry.php>, development kit `readme.txt`):
+//!
+//! ```text
+//! dataset/sequences/XX/velodyne/NNNNNN.bin   N × 4 little-endian f32: x y z reflectance
+//! dataset/sequences/XX/times.txt             one timestamp a line, seconds since the start
+//! dataset/sequences/XX/calib.txt             P0: … P3: (3×4 projections), Tr: (3×4 velo → cam0)
+//! dataset/poses/XX.txt                       12 numbers a line: row-major 3×4 [R | t]
+//! ```
+//!
+//! Frames:
+//!
+//! * **Velodyne scans** are in the velodyne frame, which follows REP-103: x forward, y left,
+//!   z up, metres. Reflectance is in `[0, 1]` and goes to [`PointCloud::intensity`].
+//! * **Poses** are `world_from_cam0`: the left grey camera's pose in the frame of the camera
+//!   at frame 0, with **camera axes: x right, y down, z forward**. Multiply by the
+//!   calibration's `cam0_from_velo` ([`KittiCalib::cam0_from_velo`]) to place scans
+//!   ([`velodyne_poses`]), and by [`flu_from_camera`] on the left to express the world frame
+//!   REP-103 style (x forward, y left, z up).
+//!
+//! [`KittiSequence::open`] finds the files of one sequence, both in the benchmark layout and
+//! with everything in one directory (`poses.txt`, `times.txt`, `calib.txt`, `velodyne/`).
+//!
+//! [`PointCloud::intensity`]: raypath_geometry::PointCloud::intensity
+
+mod calib;
+mod poses;
+mod sequence;
+mod velodyne;
+
+use std::path::Path;
+
+use raypath_geometry::Aabb3;
+
+use crate::summary::{BoundingBox, Summary, TimeSpan};
+use crate::{Format, Result};
+
+pub use calib::{KittiCalib, parse_calib, read_calib};
+pub use poses::{
+    flu_from_camera, parse_poses, parse_times, read_poses, read_times, velodyne_poses,
+};
+pub use sequence::{KittiScan, KittiScans, KittiSequence, ScanFile};
+pub use velodyne::{VELODYNE_POINT_BYTES, parse_velodyne, read_velodyne, velodyne_point_count};
+
+/// Summarizes a KITTI sequence directory or one of its files, read as `format`.
+pub fn summarize(path: &Path, format: Format) -> Result<Summary> {
+    let mut summary = Summary::new(format.name());
+    match format {
+        Format::KittiVelodyne => {
+            let cloud = read_velodyne(path)?;
+            summary.points = Some(cloud.len() as u64);
+            summary.bbox = BoundingBox::from_aabb(&cloud.bounding_box());
+        }
+        Format::KittiPoses => {
+            let poses = read_poses(path)?;
+            summary.poses = Some(poses.len() as u64);
+            summary.bbox = pose_bbox(&poses);
+        }
+        Format::KittiTimes => {
+            let times = read_times(path)?;
+            summary = summary.with_extra("times", times.len() as u64);
+            summary.time_span = TimeSpan::from_times(times);
+        }
+        Format::KittiCalib => {
+            let calib = read_calib(path)?;
+            let keys: Vec<&str> = calib.keys().collect();
+            summary = summary.with_extra("keys", keys);
+        }
+        _ => return summarize_sequence(path, summary),
+    }
+    Ok(summary)
+}
+
+fn summarize_sequence(path: &Path, mut summary: Summary) -> Result<Summary> {
+    let sequence = KittiSequence::open(path)?;
+    if sequence.velodyne_dir.is_some() {
+        summary.scans = Some(sequence.scan_files.len() as u64);
+        summary.points = Some(sequence.count_points()?);
+    }
+    if sequence.poses_path.is_some() {
+        let poses = sequence.poses()?;
+        summary.poses = Some(poses.len() as u64);
+        summary.bbox = pose_bbox(&poses);
+    }
+    if sequence.times_path.is_some() {
+        let times = sequence.times()?;
+        summary = summary.with_extra("times", times.len() as u64);
+        summary.time_span = TimeSpan::from_times(times);
+    }
+    if let Some(calib) = sequence.calib()? {
+        let keys: Vec<&str> = calib.keys().collect();
+        summary = summary.with_extra("calib_keys", keys);
+    }
+    if let Some(name) = &sequence.name {
+        summary = summary.with_extra("sequence", name.clone());
+    }
+    Ok(summary)
+}
+
+/// Reads the next line of `lines` into `buf` (reused, so no allocation per line), for parsers
+/// that need the reader again (to build errors) while they look at the line. False at the end.
+pub(crate) fn next_line_into(
+    lines: &mut crate::source::LineReader,
+    buf: &mut String,
+) -> Result<bool> {
+    buf.clear();
+    match lines.next_line()? {
+        Some(line) => {
+            buf.push_str(line);
+            Ok(true)
+        }
+        None => Ok(false),
+    }
+}
+
+/// Bounding box of pose positions (the frame of the poses).
+fn pose_bbox(poses: &[raypath_geometry::Pose3]) -> Option<BoundingBox> {
+    let mut bbox = Aabb3::empty();
+    for pose in poses {
+        bbox.extend(&pose.translation().into());
+    }
+    BoundingBox::from_aabb(&bbox)
+}
