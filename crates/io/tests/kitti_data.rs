@@ -1,6 +1,9 @@
 //! KITTI readers on the real pole-map sequences (RAYPATH_DATA/kitti-poles) and on a
 //! synthetic sequence in the benchmark layout.
 
+// Test helpers (outside #[test] functions) panic on setup failures too.
+#![allow(clippy::unwrap_used)]
+
 use std::path::{Path, PathBuf};
 
 use raypath_io::kitti::{self, KittiSequence};

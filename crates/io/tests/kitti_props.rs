@@ -1,5 +1,8 @@
 //! KITTI file readers: known answers, error places, and no panic on mutated input.
 
+// Test helpers (outside #[test] functions) panic on setup failures too.
+#![allow(clippy::unwrap_used)]
+
 use std::io::Cursor;
 
 use proptest::prelude::*;

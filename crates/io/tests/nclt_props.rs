@@ -1,5 +1,8 @@
 //! NCLT readers on synthetic files: decoding, frames, sessions, error places, no panic.
 
+// Test helpers (outside #[test] functions) panic on setup failures too.
+#![allow(clippy::unwrap_used)]
+
 use std::io::Cursor;
 use std::path::Path;
 

@@ -1,5 +1,8 @@
 //! OctoMap readers and writers on the real sample files (RAYPATH_DATA/octomap).
 
+// Test helpers (outside #[test] functions) panic on setup failures too.
+#![allow(clippy::unwrap_used)]
+
 use std::path::PathBuf;
 
 use raypath_io::octomap::{self, KEY_OFFSET, TREE_DEPTH};

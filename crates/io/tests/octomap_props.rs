@@ -1,5 +1,8 @@
 //! OctoMap `.graph` and `.bt`: round trips, error places, and no panic on any input.
 
+// Test helpers (outside #[test] functions) panic on setup failures too.
+#![allow(clippy::unwrap_used)]
+
 use nalgebra::{Point3, Vector3};
 use proptest::prelude::*;
 use raypath_geometry::{PointCloud, Pose3};

@@ -1,5 +1,8 @@
 //! Point CSV reader: the real pole maps, known answers, error places, no panic.
 
+// Test helpers (outside #[test] functions) panic on setup failures too.
+#![allow(clippy::unwrap_used)]
+
 use std::io::Cursor;
 use std::path::PathBuf;
 
