@@ -64,7 +64,8 @@ impl PointCsv {
     /// Row `i`, `None` past the end.
     pub fn row(&self, i: usize) -> Option<&[f64]> {
         let n = self.columns.len();
-        self.values.get(i * n..(i + 1) * n)
+        let start = i.checked_mul(n)?;
+        self.values.get(start..start.checked_add(n)?)
     }
 
     /// The rows in order.

@@ -171,8 +171,8 @@ fn distinct_labels(labels: &[u32]) -> Vec<u32> {
 }
 
 /// Bounding box of positions.
-fn positions_bbox<'a>(
-    positions: impl IntoIterator<Item = nalgebra::Point3<f64>> + 'a,
+fn positions_bbox(
+    positions: impl IntoIterator<Item = nalgebra::Point3<f64>>,
 ) -> Option<BoundingBox> {
     let mut bbox = Aabb3::empty();
     for p in positions {
