@@ -40,7 +40,7 @@
 //!
 //! ## Optional features
 //!
-//! * `testing`: proptest strategies ([`testing`]) for poses, rays and grids, for other crates'
+//! * `testing`: proptest strategies (module `testing`) for poses, rays and grids, for other crates'
 //!   property tests.
 
 mod aabb;
@@ -61,7 +61,8 @@ pub use error::GeometryError;
 pub use grid::{Grid2, Grid3};
 pub use point_cloud::PointCloud;
 pub use pose::{Pose2, Pose3, wrap_angle};
-pub use range_image::*;
 pub use ray::{Range, Ray2, Ray3};
 pub use scan2::Scan2;
-pub use traversal::*;
+pub use traversal::{
+    CellCrossing, CellCrossing2, CellCrossing3, Traversal, Traversal2, Traversal3,
+};

@@ -346,7 +346,11 @@ mod tests {
         let pose = Pose3::from_xyz_rpy(1.0, -2.0, 3.0, 0.1, -0.2, 0.3);
         let back = Pose3::from_matrix3x4(&pose.to_matrix3x4());
         assert!((back.translation() - pose.translation()).norm() < 1e-12);
-        assert!(back.rotation().angle_to(&pose.rotation()) < 1e-12);
+        // `angle_to` goes through acos (~1e-8 resolution near zero), so compare matrices;
+        // `from_matrix3x4` re-orthonormalizes to its convergence threshold of 1e-12.
+        let rotation_error = back.rotation().to_rotation_matrix().matrix()
+            - pose.rotation().to_rotation_matrix().matrix();
+        assert!(rotation_error.norm() < 1e-10);
         let (r, p, y) = back.rpy();
         assert!((r - 0.1).abs() < 1e-12 && (p + 0.2).abs() < 1e-12 && (y - 0.3).abs() < 1e-12);
     }

@@ -1,1 +1,0 @@
-//! Amanatides–Woo traversal (placeholder, being written).
