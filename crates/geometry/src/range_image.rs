@@ -1,1 +1,0 @@
-//! Organized range images (placeholder, being written).
