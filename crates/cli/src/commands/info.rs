@@ -104,11 +104,7 @@ pub fn render_text(path: &std::path::Path, s: &Summary) -> String {
         );
     }
     for (key, value) in &s.extra {
-        let text = match value {
-            serde_json::Value::String(text) => text.clone(),
-            other => other.to_string(),
-        };
-        push(&key.replace('_', " "), text);
+        push(&key.replace('_', " "), render_value(value));
     }
     let width = lines
         .iter()
@@ -120,4 +116,42 @@ pub fn render_text(path: &std::path::Path, s: &Summary) -> String {
         .iter()
         .map(|(k, v)| format!("{:<width$}  {v}\n", format!("{k}:")))
         .collect()
+}
+
+/// A JSON value as text: strings bare, flat arrays and objects as lists, nested ones as JSON.
+fn render_value(value: &serde_json::Value) -> String {
+    use serde_json::Value;
+    let scalar = |v: &Value| match v {
+        Value::String(text) => Some(text.clone()),
+        Value::Array(_) | Value::Object(_) => None,
+        other => Some(other.to_string()),
+    };
+    match value {
+        Value::Array(items) => items
+            .iter()
+            .map(scalar)
+            .collect::<Option<Vec<_>>>()
+            .map_or_else(|| value.to_string(), |items| items.join(", ")),
+        Value::Object(map) => map
+            .iter()
+            .map(|(k, v)| scalar(v).map(|v| format!("{k} {v}")))
+            .collect::<Option<Vec<_>>>()
+            .map_or_else(|| value.to_string(), |items| items.join(", ")),
+        other => scalar(other).unwrap_or_default(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn renders_flat_values_as_lists() {
+        let v = serde_json::json!({"FLASER": 910, "ODOM": 14541});
+        assert_eq!(render_value(&v), "FLASER 910, ODOM 14541");
+        assert_eq!(render_value(&serde_json::json!(["x", "y"])), "x, y");
+        assert_eq!(render_value(&serde_json::json!("ascii")), "ascii");
+        let nested = serde_json::json!({"min": [1, 2]});
+        assert_eq!(render_value(&nested), nested.to_string());
+    }
 }
