@@ -229,7 +229,7 @@ fn length(reach: f64) -> impl Strategy<Value = f64> {
 }
 
 fn config() -> ProptestConfig {
-    ProptestConfig::with_cases(1000)
+    ProptestConfig::with_cases(3000)
 }
 
 proptest! {
