@@ -60,7 +60,8 @@ pub type CellCrossing3 = CellCrossing<3>;
 ///   the intermediate cells with zero length (`t_enter == t_exit`); ties between axes step
 ///   the higher axis first (z before y before x). No cell is skipped or repeated.
 /// * **First cell.** The cell the segment occupies just after its start: a start exactly on a
-///   face, moving towards lower indices, begins in the lower cell.
+///   face, moving towards lower indices, begins in the lower cell (unless, by rounding, the
+///   coordinate never leaves that face: then the axis counts as not moving, below).
 /// * **Last cell.** For an endpoint inside the grid it is [`Grid3::cell_of`](crate::Grid3::cell_of)
 ///   of the endpoint: a point on a shared face belongs to the cell with the larger index, so a
 ///   ray that ends exactly on a face it reaches moving towards higher indices ends with a
@@ -69,7 +70,8 @@ pub type CellCrossing3 = CellCrossing<3>;
 /// * **Degenerate input.** Zero-length segments, segments whose part inside the grid has zero
 ///   length (they only touch its boundary), negative or NaN lengths and non-finite origins or
 ///   directions yield **nothing**. A length of `+∞` traces the ray until it leaves the grid.
-/// * **Axis-parallel rays** (zero direction components) never step along those axes. A ray
+/// * **Axis-parallel rays** (zero direction components, or a coordinate that rounding keeps
+///   constant over the segment) never step along those axes. A ray
 ///   lying in a cell face is reported in the cells on its larger-index side, like
 ///   [`Grid3::cell_of`](crate::Grid3::cell_of) — except on the grid's upper boundary face,
 ///   where it is reported in the last layer of cells.
@@ -210,13 +212,17 @@ impl<const N: usize> Traversal<N> {
             } else {
                 clamp_cell(u_end.floor(), dim)
             };
-            // Rounding can never reverse the direction of travel.
-            let (steps, step_up) = if !moving {
-                (0, true)
+            // The two rules above disagree only when the coordinate does not change at all
+            // (the start and end lie on the same face, up to rounding): then the axis does not
+            // move and, like a zero component, uses the `cell_of` tie-break (the larger
+            // index) at both ends. Rounding can never reverse the direction of travel.
+            let (start, steps, step_up) = if !moving {
+                (start, 0, true)
             } else if d > 0.0 {
-                (end.saturating_sub(start), true)
+                (start, end.saturating_sub(start), true)
             } else {
-                (start.saturating_sub(end), false)
+                let start = start.max(end);
+                (start, start - end, false)
             };
             walk.cell[axis] = start;
             walk.index += start * stride;

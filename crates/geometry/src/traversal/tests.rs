@@ -195,3 +195,22 @@ fn exact_size_and_fused() {
     assert_eq!(walk.len(), 0);
     assert!(walk.next().is_none());
 }
+
+#[test]
+fn degenerate_entry_onto_a_face_keeps_the_endpoint_cell() {
+    // Found by the property tests: a segment from outside that ends exactly on the grid's
+    // lower x face and on the face y = 2 (between rows 1 and 2), moving down in y. Rounding
+    // leaves a ~1e-16 m piece inside the grid; its cell must be `cell_of(endpoint)`.
+    let grid = Grid2::new(Point2::new(-2.006482540402752, 1.875), 0.0625, [2, 11]).unwrap();
+    let origin = Point2::new(-2.193982540402752, 2.046033747762146);
+    let end = Point2::new(-2.006482540402752, 2.0);
+    let ray = Ray2::new(origin, end - origin, Range::Hit((end - origin).norm())).unwrap();
+    let crossings: Vec<_> = grid.traverse_ray(&ray, f64::INFINITY).collect();
+    assert_eq!(crossings.len(), 1, "{crossings:?}");
+    assert_eq!(
+        Some(crossings[0].cell),
+        grid.cell_of(&ray.endpoint().unwrap())
+    );
+    assert_eq!(crossings[0].cell, [0, 2]);
+    assert!(crossings.iter().map(|c| c.length()).sum::<f64>() < 1e-12);
+}
