@@ -22,8 +22,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run an evaluation (or `all`), print its table, write docs/results/<name>.md and
-    /// target/eval/<name>.json.
+    /// Run an evaluation (or `all`), print its table, write `docs/results/<name>.md` and
+    /// `target/eval/<name>.json`.
     Eval {
         /// Evaluation name, `all`, or `list`.
         name: String,

@@ -28,7 +28,7 @@ fn raypath(args: &[&str]) -> Output {
 }
 
 fn info_json(path: &std::path::Path) -> serde_json::Value {
-    let out = raypath(&["info", path.to_str().unwrap(), "--json"]);
+    let out = raypath(&["info", path.to_str().expect("UTF-8 path"), "--json"]);
     assert!(
         out.status.success(),
         "raypath info {} failed: {}",
@@ -148,7 +148,7 @@ fn broken_file_exits_2_naming_the_place() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("broken.log:1"), "{stderr}");
 
-    let out = raypath(&["info", path.to_str().unwrap(), "--json"]);
+    let out = raypath(&["info", path.to_str().expect("UTF-8 path"), "--json"]);
     assert_eq!(out.status.code(), Some(2));
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(json["error"].as_str().unwrap().contains("broken.log:1"));
