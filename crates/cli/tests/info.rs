@@ -1,24 +1,7 @@
 //! `raypath info` end to end: the binary on real data, on broken files and on bad arguments.
 
-use std::path::PathBuf;
+use raypath_io::data::require;
 use std::process::{Command, Output};
-
-fn data_dir() -> PathBuf {
-    std::env::var_os("RAYPATH_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../datasets")))
-}
-
-/// The data file, or `None` (with a message) when the data set is not installed.
-fn data_file(relative: &str) -> Option<PathBuf> {
-    let path = data_dir().join(relative);
-    if path.exists() {
-        Some(path)
-    } else {
-        eprintln!("skipping: {} not found (set RAYPATH_DATA)", path.display());
-        None
-    }
-}
 
 fn raypath(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_raypath"))
@@ -40,7 +23,7 @@ fn info_json(path: &std::path::Path) -> serde_json::Value {
 
 #[test]
 fn intel_corrected_log() {
-    let Some(path) = data_file("carmen/corrected/intel-corrected.log.gz") else {
+    let Some(path) = require("carmen/corrected/intel-corrected.log.gz") else {
         return;
     };
     let json = info_json(&path);
@@ -66,7 +49,7 @@ fn every_carmen_log_matches_the_data_readme() {
         ("corrected/intel-corrected.log.gz", 910, 180),
     ];
     for (name, scans, beams) in expected {
-        let Some(path) = data_file(&format!("carmen/{name}")) else {
+        let Some(path) = require(format!("carmen/{name}")) else {
             return;
         };
         let json = info_json(&path);
@@ -80,7 +63,7 @@ fn every_carmen_log_matches_the_data_readme() {
         ("raw/fr-clinic_robotlaser.clf.bz2", 6917, None),
     ];
     for (name, scans, odometry) in raw {
-        let Some(path) = data_file(&format!("carmen/{name}")) else {
+        let Some(path) = require(format!("carmen/{name}")) else {
             return;
         };
         let json = info_json(&path);
@@ -93,7 +76,7 @@ fn every_carmen_log_matches_the_data_readme() {
 
 #[test]
 fn synpeb_sample_pcd() {
-    let Some(path) = data_file("planes/synpeb-sample-100x100.pcd") else {
+    let Some(path) = require("planes/synpeb-sample-100x100.pcd") else {
         return;
     };
     let json = info_json(&path);
@@ -110,18 +93,18 @@ fn synpeb_sample_pcd() {
 
 #[test]
 fn octomap_samples() {
-    if let Some(path) = data_file("octomap/geb079.bt") {
+    if let Some(path) = require("octomap/geb079.bt") {
         let json = info_json(&path);
         assert_eq!(json["format"], "octomap-bt");
         assert_eq!(json["nodes"], 532_566);
     }
-    if let Some(path) = data_file("octomap/spherical_scan.graph") {
+    if let Some(path) = require("octomap/spherical_scan.graph") {
         let json = info_json(&path);
         assert_eq!(json["format"], "octomap-graph");
         assert_eq!(json["nodes"], 1);
         assert_eq!(json["points"], 10_201);
     }
-    if let Some(path) = data_file("octomap/scan.dat.bz2") {
+    if let Some(path) = require("octomap/scan.dat.bz2") {
         let json = info_json(&path);
         assert_eq!(json["format"], "xyz");
         assert_eq!(json["points"], 88_206);
@@ -130,7 +113,7 @@ fn octomap_samples() {
 
 #[test]
 fn kitti_directory_is_one_input() {
-    let Some(path) = data_file("kitti-poles/00") else {
+    let Some(path) = require("kitti-poles/00") else {
         return;
     };
     let json = info_json(&path);

@@ -1,7 +1,8 @@
 //! Traversal throughput in cells per second (Criterion `Throughput::Elements` = cells
 //! visited per batch of rays), single thread.
 //!
-//! Workloads (seeded, identical to `cargo xtask eval geometry`):
+//! Workloads: `raypath_geometry::testing::workloads` (seeded, identical to
+//! `cargo xtask eval geometry`):
 //! * `3d/inside`: a 200³ grid of 0.1 m voxels (a 20 m cube); rays start uniformly inside it, in
 //!   uniformly random directions, and hit at 0.5–30 m (10 % no-returns traced to 30 m).
 //! * `3d/outside`: the same grid; rays start on a sphere of radius 25 m around it, aimed at
@@ -14,95 +15,13 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_main};
-use nalgebra::{Point2, Point3, Vector2, Vector3};
-use raypath_geometry::{Grid2, Grid3, Range, Ray2, Ray3};
+use raypath_geometry::testing::workloads::{
+    grid2, grid3, rays_inside_2d, rays_inside_3d, rays_outside_3d,
+};
+use raypath_geometry::{Grid2, Grid3, Ray2, Ray3};
 
 /// Rays per Criterion iteration.
 const RAYS: usize = 10_000;
-
-/// SplitMix64: a tiny seeded generator, the same one the xtask evaluation uses.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[lo, hi)`.
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn unit3(&mut self) -> Vector3<f64> {
-        let z = self.uniform(-1.0, 1.0);
-        let phi = self.uniform(0.0, std::f64::consts::TAU);
-        let r = (1.0 - z * z).sqrt();
-        Vector3::new(r * phi.cos(), r * phi.sin(), z)
-    }
-}
-
-fn grid3() -> Grid3 {
-    Grid3::new(Point3::new(-10.0, -10.0, -10.0), 0.1, [200, 200, 200]).expect("valid grid")
-}
-
-fn grid2() -> Grid2 {
-    Grid2::new(Point2::new(-100.0, -100.0), 0.1, [2000, 2000]).expect("valid grid")
-}
-
-fn rays_inside_3d(n: usize, seed: u64) -> Vec<Ray3> {
-    let mut rng = SplitMix64(seed);
-    (0..n)
-        .map(|_| {
-            let origin = Point3::new(
-                rng.uniform(-10.0, 10.0),
-                rng.uniform(-10.0, 10.0),
-                rng.uniform(-10.0, 10.0),
-            );
-            let range = if rng.uniform(0.0, 1.0) < 0.1 {
-                Range::NoReturn
-            } else {
-                Range::Hit(rng.uniform(0.5, 30.0))
-            };
-            Ray3::new(origin, rng.unit3(), range).expect("unit direction")
-        })
-        .collect()
-}
-
-fn rays_outside_3d(n: usize, seed: u64) -> Vec<Ray3> {
-    let mut rng = SplitMix64(seed);
-    let mut rays = Vec::with_capacity(n);
-    while rays.len() < n {
-        let origin = Point3::from(rng.unit3() * 25.0);
-        let target = Point3::new(
-            rng.uniform(-10.0, 10.0),
-            rng.uniform(-10.0, 10.0),
-            rng.uniform(-10.0, 10.0),
-        );
-        rays.extend(Ray3::new(origin, target - origin, Range::NoReturn));
-    }
-    rays
-}
-
-fn rays_inside_2d(n: usize, seed: u64) -> Vec<Ray2> {
-    let mut rng = SplitMix64(seed);
-    (0..n)
-        .map(|_| {
-            let origin = Point2::new(rng.uniform(-50.0, 50.0), rng.uniform(-50.0, 50.0));
-            let angle = rng.uniform(0.0, std::f64::consts::TAU);
-            let range = if rng.uniform(0.0, 1.0) < 0.1 {
-                Range::NoReturn
-            } else {
-                Range::Hit(rng.uniform(0.5, 50.0))
-            };
-            Ray2::new(origin, Vector2::new(angle.cos(), angle.sin()), range)
-                .expect("unit direction")
-        })
-        .collect()
-}
 
 /// Sum of in-cell lengths over all rays (what a decay-rate map accumulates).
 fn trace3(grid: &Grid3, rays: &[Ray3], max_range_m: f64) -> f64 {

@@ -30,6 +30,7 @@ mod error;
 mod summary;
 
 pub mod carmen;
+pub mod data;
 pub mod kitti;
 pub mod nclt;
 pub mod octomap;

@@ -7,24 +7,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use raypath_io::carmen::{CarmenReader, LaserKind, LaserMessage, Record};
-
-fn data_dir() -> PathBuf {
-    match std::env::var_os("RAYPATH_DATA") {
-        Some(dir) if !dir.is_empty() => PathBuf::from(dir),
-        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../datasets"),
-    }
-}
-
-/// The file, or `None` (with a message) when it is not there.
-fn data_file(relative: &str) -> Option<PathBuf> {
-    let path = data_dir().join(relative);
-    if path.is_file() {
-        Some(path)
-    } else {
-        eprintln!("skipping: {} not found (set RAYPATH_DATA)", path.display());
-        None
-    }
-}
+use raypath_io::data::require;
 
 /// What a pass over a log counts.
 #[derive(Default)]
@@ -66,7 +49,7 @@ const CORRECTED: [(&str, u64, usize); 10] = [
 ];
 
 fn corrected(log: &str) -> Option<PathBuf> {
-    data_file(&format!("carmen/corrected/{log}-corrected.log.gz"))
+    require(format!("carmen/corrected/{log}-corrected.log.gz"))
 }
 
 #[test]
@@ -97,7 +80,7 @@ fn raw_logs_have_the_published_counts() {
         ),
     ];
     for (file, kind, scans, odometry) in cases {
-        let Some(path) = data_file(&format!("carmen/raw/{file}")) else {
+        let Some(path) = require(format!("carmen/raw/{file}")) else {
             continue;
         };
         let counts = count(&path);
@@ -147,7 +130,7 @@ fn no_return_codes_match_the_readme() {
         ),
     ];
     for (file, kind, code) in raw {
-        let Some(path) = data_file(&format!("carmen/raw/{file}")) else {
+        let Some(path) = require(format!("carmen/raw/{file}")) else {
             continue;
         };
         let estimate = CarmenReader::open(&path).unwrap().no_return(kind).unwrap();
@@ -187,7 +170,7 @@ fn find_laser(path: &Path, pick: impl Fn(&LaserMessage) -> bool) -> Option<Laser
 
 #[test]
 fn intel_corrected_scan_is_the_raw_scan_with_the_same_logger_time() {
-    let (Some(corrected), Some(raw)) = (corrected("intel"), data_file("carmen/raw/intel.clf.bz2"))
+    let (Some(corrected), Some(raw)) = (corrected("intel"), require("carmen/raw/intel.clf.bz2"))
     else {
         return;
     };
@@ -207,7 +190,7 @@ fn intel_corrected_scan_is_the_raw_scan_with_the_same_logger_time() {
 #[test]
 #[allow(clippy::approx_constant)] // the angles as printed in the log
 fn robotlaser_angles_and_poses_come_from_the_line() {
-    let Some(path) = data_file("carmen/raw/fr-clinic_robotlaser.clf.bz2") else {
+    let Some(path) = require("carmen/raw/fr-clinic_robotlaser.clf.bz2") else {
         return;
     };
     let first = find_laser(&path, |_| true).unwrap();
@@ -256,7 +239,7 @@ fn summarize_intel_corrected() {
 
 #[test]
 fn summarize_fr_clinic_counts_robotlaser_beams() {
-    let Some(path) = data_file("carmen/raw/fr-clinic_robotlaser.clf.bz2") else {
+    let Some(path) = require("carmen/raw/fr-clinic_robotlaser.clf.bz2") else {
         return;
     };
     let summary = raypath_io::summarize(&path).unwrap();

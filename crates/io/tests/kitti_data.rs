@@ -6,21 +6,8 @@
 
 use std::path::{Path, PathBuf};
 
+use raypath_io::data::require;
 use raypath_io::kitti::{self, KittiSequence};
-
-fn data_file(relative: &str) -> Option<PathBuf> {
-    let root = std::env::var_os("RAYPATH_DATA").map_or_else(
-        || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../datasets"),
-        PathBuf::from,
-    );
-    let path = root.join(relative);
-    if path.exists() {
-        Some(path)
-    } else {
-        eprintln!("skipping: {} not found (set RAYPATH_DATA)", path.display());
-        None
-    }
-}
 
 fn line_count(path: &Path) -> usize {
     std::fs::read_to_string(path)
@@ -32,7 +19,7 @@ fn line_count(path: &Path) -> usize {
 
 #[test]
 fn pole_sequences_have_one_time_per_pose() {
-    let Some(root) = data_file("kitti-poles") else {
+    let Some(root) = require("kitti-poles") else {
         return;
     };
     for seq in ["00", "01", "02", "03", "04", "05", "06", "07"] {
@@ -55,7 +42,7 @@ fn pole_sequences_have_one_time_per_pose() {
 
 #[test]
 fn sequence_00_summary() {
-    let Some(dir) = data_file("kitti-poles/00") else {
+    let Some(dir) = require("kitti-poles/00") else {
         return;
     };
     let poses = kitti::read_poses(&dir.join("poses.txt")).unwrap();

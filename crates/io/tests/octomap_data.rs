@@ -3,28 +3,12 @@
 // Test helpers (outside #[test] functions) panic on setup failures too.
 #![allow(clippy::unwrap_used)]
 
-use std::path::PathBuf;
-
+use raypath_io::data::require;
 use raypath_io::octomap::{self, KEY_OFFSET, TREE_DEPTH};
-
-/// A file under the data directory, `None` (with a message) when it is absent.
-fn data_file(relative: &str) -> Option<PathBuf> {
-    let root = std::env::var_os("RAYPATH_DATA").map_or_else(
-        || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../datasets"),
-        PathBuf::from,
-    );
-    let path = root.join(relative);
-    if path.exists() {
-        Some(path)
-    } else {
-        eprintln!("skipping: {} not found (set RAYPATH_DATA)", path.display());
-        None
-    }
-}
 
 #[test]
 fn spherical_scan_graph_has_one_node_of_10201_points() {
-    let Some(path) = data_file("octomap/spherical_scan.graph") else {
+    let Some(path) = require("octomap/spherical_scan.graph") else {
         return;
     };
     assert_eq!(std::fs::metadata(&path).unwrap().len(), 285_708);
@@ -69,7 +53,7 @@ fn spherical_scan_graph_has_one_node_of_10201_points() {
 
 #[test]
 fn geb079_tree_matches_its_header_and_lattice() {
-    let Some(path) = data_file("octomap/geb079.bt") else {
+    let Some(path) = require("octomap/geb079.bt") else {
         return;
     };
     let tree = octomap::read_bt(&path).unwrap();

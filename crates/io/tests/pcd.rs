@@ -1,19 +1,11 @@
 //! PCD reader and writer: known answers, round trips in all encodings, the SynPEB sample.
 #![allow(clippy::unwrap_used)]
 
-use std::path::PathBuf;
-
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 use proptest::prelude::*;
 use raypath_geometry::{PointCloud, Pose3};
 use raypath_io::pcd::{self, DataEncoding, LabelSource, PcdCloud, ReadOptions, WriteOptions, lzf};
 use raypath_io::{Location, summarize};
-
-fn data_dir() -> PathBuf {
-    std::env::var_os("RAYPATH_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../datasets"))
-}
 
 fn write(cloud: &PointCloud, options: &WriteOptions) -> Vec<u8> {
     let mut bytes = Vec::new();
@@ -250,11 +242,9 @@ fn lzf_is_reachable_from_the_public_api() {
 
 #[test]
 fn synpeb_sample_reads_and_round_trips() {
-    let path = data_dir().join("planes/synpeb-sample-100x100.pcd");
-    if !path.exists() {
-        eprintln!("skipping: {} not found (set RAYPATH_DATA)", path.display());
+    let Some(path) = raypath_io::data::require("planes/synpeb-sample-100x100.pcd") else {
         return;
-    }
+    };
     let read = pcd::read_pcd(&path, &ReadOptions::synpeb()).unwrap();
     let cloud = &read.cloud;
     assert_eq!((cloud.width, cloud.height, cloud.len()), (100, 100, 10_000));

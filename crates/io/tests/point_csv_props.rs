@@ -4,25 +4,11 @@
 #![allow(clippy::unwrap_used)]
 
 use std::io::Cursor;
-use std::path::PathBuf;
 
 use proptest::prelude::*;
 use raypath_io::Location;
+use raypath_io::data::require;
 use raypath_io::point_csv::{PointCsv, PointCsvReader};
-
-fn data_file(relative: &str) -> Option<PathBuf> {
-    let root = std::env::var_os("RAYPATH_DATA").map_or_else(
-        || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../datasets"),
-        PathBuf::from,
-    );
-    let path = root.join(relative);
-    if path.exists() {
-        Some(path)
-    } else {
-        eprintln!("skipping: {} not found (set RAYPATH_DATA)", path.display());
-        None
-    }
-}
 
 #[test]
 fn nclt_pole_maps() {
@@ -31,7 +17,7 @@ fn nclt_pole_maps() {
         ("pole-map-polemeans.csv", 1635, &["x", "y", "w"][..]),
         ("pole-map-segment-positions.csv", 12999, &["x", "y"][..]),
     ] {
-        let Some(path) = data_file(&format!("nclt-poles/{name}")) else {
+        let Some(path) = require(format!("nclt-poles/{name}")) else {
             return;
         };
         let csv = PointCsv::read(&path).unwrap();
@@ -48,14 +34,14 @@ fn nclt_pole_maps() {
             assert_eq!((bbox.min[2], bbox.max[2]), (0.0, 0.0));
         }
     }
-    let Some(path) = data_file("nclt-poles/pole-map-polemeans.csv") else {
+    let Some(path) = require("nclt-poles/pole-map-polemeans.csv") else {
         return;
     };
     // Pole widths are centimetres to decimetres.
     let widths = PointCsv::read(&path).unwrap().column("w").unwrap();
     assert!(widths.iter().all(|&w| w > 0.0 && w < 1.0));
     // Ground-truth pole heights are metres above the ground (z column).
-    let Some(path) = data_file("nclt-poles/ground-truth-poles.csv") else {
+    let Some(path) = require("nclt-poles/ground-truth-poles.csv") else {
         return;
     };
     let poles = PointCsv::read(&path).unwrap();
@@ -65,7 +51,7 @@ fn nclt_pole_maps() {
 
 #[test]
 fn kitti_pole_maps() {
-    let Some(root) = data_file("kitti-poles") else {
+    let Some(root) = require("kitti-poles") else {
         return;
     };
     for seq in ["00", "01", "02", "03", "04", "05", "06", "07"] {

@@ -2,18 +2,11 @@
 #![allow(clippy::unwrap_used)]
 
 use std::io::Write;
-use std::path::PathBuf;
 
 use nalgebra::Point3;
 use proptest::prelude::*;
 use raypath_io::xyz::{self, XyzReader};
 use raypath_io::{Format, Location, summarize};
-
-fn data_dir() -> PathBuf {
-    std::env::var_os("RAYPATH_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../datasets"))
-}
 
 fn reader(text: &str) -> XyzReader {
     XyzReader::from_reader(
@@ -94,11 +87,9 @@ fn reads_gzip_and_summarizes() {
 
 #[test]
 fn octomap_scan_has_88206_points() {
-    let path = data_dir().join("octomap/scan.dat.bz2");
-    if !path.exists() {
-        eprintln!("skipping: {} not found (set RAYPATH_DATA)", path.display());
+    let Some(path) = raypath_io::data::require("octomap/scan.dat.bz2") else {
         return;
-    }
+    };
     let cloud = xyz::read_xyz(&path).unwrap();
     assert_eq!(cloud.len(), 88_206);
     assert_eq!(cloud.points[0], Point3::new(-0.0434742, -4.82982, 0.499645));

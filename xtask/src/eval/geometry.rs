@@ -19,94 +19,18 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use anyhow::{Context, Result, ensure};
-use nalgebra::{Point2, Point3, Unit, Vector2, Vector3};
-use raypath_geometry::{Grid2, Grid3, Range, Ray2, Ray3};
+use anyhow::{Result, ensure};
+use nalgebra::{Unit, Vector3};
+use raypath_geometry::testing::workloads::{
+    grid2, grid3, rays_inside_2d, rays_inside_3d, rays_outside_3d,
+};
+use raypath_geometry::{Grid2, Grid3, Ray2, Ray3};
 
 use super::{EvalContext, EvalReport, median};
 use crate::table::{Table, fmt_num};
 
 /// The aim for 3-D traversal on one core, cells per second.
 const AIM_3D_CELLS_PER_SEC: f64 = 1e8;
-
-/// SplitMix64: the seeded generator the Criterion benchmark uses too.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[lo, hi)`.
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn unit3(&mut self) -> Vector3<f64> {
-        let z = self.uniform(-1.0, 1.0);
-        let phi = self.uniform(0.0, std::f64::consts::TAU);
-        let r = (1.0 - z * z).sqrt();
-        Vector3::new(r * phi.cos(), r * phi.sin(), z)
-    }
-}
-
-fn rays_inside_3d(n: usize, seed: u64) -> Vec<Ray3> {
-    let mut rng = SplitMix64(seed);
-    let mut rays = Vec::with_capacity(n);
-    while rays.len() < n {
-        let origin = Point3::new(
-            rng.uniform(-10.0, 10.0),
-            rng.uniform(-10.0, 10.0),
-            rng.uniform(-10.0, 10.0),
-        );
-        let range = if rng.uniform(0.0, 1.0) < 0.1 {
-            Range::NoReturn
-        } else {
-            Range::Hit(rng.uniform(0.5, 30.0))
-        };
-        rays.extend(Ray3::new(origin, rng.unit3(), range));
-    }
-    rays
-}
-
-fn rays_outside_3d(n: usize, seed: u64) -> Vec<Ray3> {
-    let mut rng = SplitMix64(seed);
-    let mut rays = Vec::with_capacity(n);
-    while rays.len() < n {
-        let origin = Point3::from(rng.unit3() * 25.0);
-        let target = Point3::new(
-            rng.uniform(-10.0, 10.0),
-            rng.uniform(-10.0, 10.0),
-            rng.uniform(-10.0, 10.0),
-        );
-        rays.extend(Ray3::new(origin, target - origin, Range::NoReturn));
-    }
-    rays
-}
-
-fn rays_inside_2d(n: usize, seed: u64) -> Vec<Ray2> {
-    let mut rng = SplitMix64(seed);
-    let mut rays = Vec::with_capacity(n);
-    while rays.len() < n {
-        let origin = Point2::new(rng.uniform(-50.0, 50.0), rng.uniform(-50.0, 50.0));
-        let angle = rng.uniform(0.0, std::f64::consts::TAU);
-        let range = if rng.uniform(0.0, 1.0) < 0.1 {
-            Range::NoReturn
-        } else {
-            Range::Hit(rng.uniform(0.5, 50.0))
-        };
-        rays.extend(Ray2::new(
-            origin,
-            Vector2::new(angle.cos(), angle.sin()),
-            range,
-        ));
-    }
-    rays
-}
 
 /// The naive reference: from the current `t`, find the cell of a point a hair further along
 /// the ray, divide to find where the ray leaves that cell's box, record the crossing in a
@@ -332,10 +256,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     let min_repetition_secs = if ctx.quick { 0.05 } else { 0.25 };
     let load_before = load_average();
 
-    let grid3 = Grid3::new(Point3::new(-10.0, -10.0, -10.0), 0.1, [200, 200, 200])
-        .context("3-D benchmark grid")?;
-    let grid2 =
-        Grid2::new(Point2::new(-100.0, -100.0), 0.1, [2000, 2000]).context("2-D benchmark grid")?;
+    let (grid3, grid2) = (grid3(), grid2());
     let inside3 = rays_inside_3d(rays_per_case, 1);
     let outside3 = rays_outside_3d(rays_per_case, 2);
     let inside2 = rays_inside_2d(rays_per_case, 3);

@@ -19,6 +19,8 @@
 //! });
 //! ```
 
+pub mod workloads;
+
 use std::f64::consts::{PI, TAU};
 
 use nalgebra::{Point2, Point3, Unit, UnitQuaternion, Vector2, Vector3};

@@ -1,0 +1,49 @@
+//! Finding data sets: the `RAYPATH_DATA` directory.
+//!
+//! raypath's tests, examples and evaluations read data from the directory named by the
+//! environment variable `RAYPATH_DATA`. When it is unset, the `datasets/` folder of the
+//! raypath workspace is used: the nearest ancestor of the current directory that holds
+//! `datasets/manifest.json`, or `datasets/` in the current directory.
+
+use std::path::{Path, PathBuf};
+
+/// The data directory: `RAYPATH_DATA`, else the workspace's `datasets/` folder.
+pub fn data_dir() -> PathBuf {
+    if let Some(dir) = std::env::var_os("RAYPATH_DATA")
+        && !dir.is_empty()
+    {
+        return PathBuf::from(dir);
+    }
+    let cwd = std::env::current_dir().unwrap_or_else(|_| PathBuf::from("."));
+    cwd.ancestors()
+        .map(|dir| dir.join("datasets"))
+        .find(|datasets| datasets.join("manifest.json").is_file())
+        .unwrap_or_else(|| PathBuf::from("datasets"))
+}
+
+/// The path of `relative` under the data directory, when it exists.
+pub fn find(relative: impl AsRef<Path>) -> Option<PathBuf> {
+    let path = data_dir().join(relative);
+    path.exists().then_some(path)
+}
+
+/// For tests and examples that need real data: the path of `relative` under the data
+/// directory, or `None` after printing a "skipping" message that names the missing path, so a
+/// test can `return` early when the data set is not installed.
+///
+/// ```
+/// let Some(log) = raypath_io::data::require("carmen/corrected/intel-corrected.log.gz") else {
+///     return; // not installed: the message says what is missing
+/// };
+/// assert!(log.exists());
+/// ```
+pub fn require(relative: impl AsRef<Path>) -> Option<PathBuf> {
+    let found = find(relative.as_ref());
+    if found.is_none() {
+        eprintln!(
+            "skipping: {} not found (set RAYPATH_DATA to the data directory)",
+            data_dir().join(relative).display()
+        );
+    }
+    found
+}
