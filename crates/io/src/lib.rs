@@ -6,7 +6,8 @@
 //!
 //! * **Streaming.** Logs and packet streams are read record by record through iterators;
 //!   a 100 MB log never sits in memory whole. gzip and bzip2 are recognized by their first
-//!   bytes and decompressed on the fly.
+//!   bytes and decompressed on the fly; Unix `compress` (`.Z`, the SegComp packaging) is
+//!   decompressed into memory on opening.
 //! * **Typed records** in raypath's geometry types: [`raypath_geometry::Scan2`] and
 //!   [`raypath_geometry::Pose2`] for 2-D logs, [`raypath_geometry::PointCloud`] and
 //!   [`raypath_geometry::Pose3`] for 3-D data, in REP-103 frames, metres, radians and seconds.
@@ -32,6 +33,7 @@ mod summary;
 pub mod carmen;
 pub mod data;
 pub mod kitti;
+pub mod lzw;
 pub mod nclt;
 pub mod octomap;
 pub mod pcd;

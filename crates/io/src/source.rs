@@ -16,6 +16,8 @@ pub enum Compression {
     Gzip,
     /// bzip2 (`BZh`), as in `.clf.bz2`.
     Bzip2,
+    /// Unix `compress` (`1f 9d`, LZW), as in SegComp's `.Z` files.
+    Compress,
 }
 
 impl Compression {
@@ -25,6 +27,8 @@ impl Compression {
             Compression::Gzip
         } else if head.len() >= 4 && head.starts_with(b"BZh") && head[3].is_ascii_digit() {
             Compression::Bzip2
+        } else if crate::lzw::is_compressed(head) {
+            Compression::Compress
         } else {
             Compression::None
         }
@@ -42,7 +46,12 @@ pub fn peek(path: &Path, n: usize) -> Result<Vec<u8>> {
     Ok(head)
 }
 
-/// Opens a file for buffered reading, decompressing gzip and bzip2 on the fly.
+/// Largest decompressed size of a Unix `compress` file (it is decoded into memory).
+const MAX_COMPRESS_DECOMPRESSED: usize = 1 << 30;
+
+/// Opens a file for buffered reading, decompressing gzip and bzip2 on the fly. Unix
+/// `compress` (`.Z`) files are decoded into memory first (at most 1 GiB): the format has no
+/// streaming decoder here, and its users (SegComp images) are small.
 pub fn open(path: &Path) -> Result<Box<dyn BufRead + Send>> {
     let file = File::open(path).map_err(|e| Error::io(path, Location::File, e))?;
     let mut reader = BufReader::with_capacity(1 << 16, file);
@@ -59,6 +68,24 @@ pub fn open(path: &Path) -> Result<Box<dyn BufRead + Send>> {
             1 << 16,
             bzip2::bufread::MultiBzDecoder::new(reader),
         )),
+        Compression::Compress => {
+            let mut compressed = Vec::new();
+            reader
+                .read_to_end(&mut compressed)
+                .map_err(|e| Error::io(path, Location::Byte(compressed.len() as u64), e))?;
+            let bytes =
+                crate::lzw::decompress(&compressed, MAX_COMPRESS_DECOMPRESSED).map_err(|e| {
+                    Error::malformed(
+                        path,
+                        Location::Byte(e.offset),
+                        format!(
+                            "Unix compress (.Z) data: {} (or run `uncompress` on the file)",
+                            e.reason
+                        ),
+                    )
+                })?;
+            Box::new(std::io::Cursor::new(bytes))
+        }
     })
 }
 
@@ -285,6 +312,10 @@ mod tests {
         assert_eq!(Compression::sniff(b"BZh9"), Compression::Bzip2);
         assert_eq!(Compression::sniff(b"BZhx"), Compression::None);
         assert_eq!(Compression::sniff(b"FLASER"), Compression::None);
+        assert_eq!(
+            Compression::sniff(&[0x1f, 0x9d, 0x90]),
+            Compression::Compress
+        );
     }
 
     #[test]
@@ -300,6 +331,19 @@ mod tests {
         assert_eq!(lines.next_line().unwrap(), Some("three"));
         assert_eq!(lines.line_number(), 3);
         assert_eq!(lines.next_line().unwrap(), None);
+    }
+
+    #[test]
+    fn opens_unix_compress_files() {
+        let path = Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/data/lzw/tobe.Z"
+        ));
+        let mut lines = LineReader::open(path).unwrap();
+        assert_eq!(
+            lines.next_line().unwrap(),
+            Some("TOBEORNOTTOBEORTOBEORNOT#")
+        );
     }
 
     #[test]

@@ -5,8 +5,9 @@
 use std::path::{Path, PathBuf};
 
 use nalgebra::Point3;
+use raypath_io::lzw;
 use raypath_io::segcomp::{
-    self, PerceptronGeometry, RasterFormat, lzw, parse_gt_ang, parse_gt_seg, parse_range_image,
+    self, PerceptronGeometry, RasterFormat, parse_gt_ang, parse_gt_seg, parse_range_image,
 };
 use raypath_io::{Format, Location, summarize};
 

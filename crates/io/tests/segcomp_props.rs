@@ -2,7 +2,8 @@
 #![allow(clippy::unwrap_used)]
 
 use proptest::prelude::*;
-use raypath_io::segcomp::{lzw, parse_gt_ang, parse_gt_seg, parse_range_image};
+use raypath_io::lzw;
+use raypath_io::segcomp::{parse_gt_ang, parse_gt_seg, parse_range_image};
 
 fn range_file() -> Vec<u8> {
     let mut bytes = b"3 rows\n2 columns\n".to_vec();

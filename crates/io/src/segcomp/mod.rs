@@ -14,7 +14,7 @@
 //!   ≥ 10 are planes);
 //! * `perc.*.N.gt-ang` — angles between adjacent ground-truth planes ([`GroundTruthAngles`]).
 //!
-//! Every reader accepts the files plain, gzip-, bzip2- or `compress`-ed ([`lzw`]); errors
+//! Every reader accepts the files plain, gzip-, bzip2- or `compress`-ed ([`crate::lzw`]); errors
 //! name the line of a header or the byte offset in the decompressed data.
 //!
 //! ```
@@ -38,7 +38,6 @@ mod geometry;
 mod gt_ang;
 mod gt_seg;
 mod header;
-pub mod lzw;
 mod range;
 
 use std::path::Path;
@@ -52,27 +51,11 @@ pub use gt_seg::{
 pub use range::{PerceptronScan, RangeImage, parse_range_image, read_perceptron, read_range_image};
 
 use crate::summary::BoundingBox;
-use crate::{Error, Format, Location, Result, Summary, source};
+use crate::{Error, Format, Result, Summary, source};
 
-/// Largest decompressed size of a `.Z` file accepted (a SegComp image is about 1 MiB).
-const MAX_DECOMPRESSED: usize = 256 << 20;
-
-/// Reads a whole file, undoing gzip, bzip2 or Unix `compress`.
+/// Reads a whole file, undoing gzip, bzip2 or Unix `compress` (see [`source::open`]).
 pub(crate) fn load(path: &Path) -> Result<Vec<u8>> {
-    let bytes = source::read_all(path)?;
-    if !lzw::is_compressed(&bytes) {
-        return Ok(bytes);
-    }
-    lzw::decompress(&bytes, MAX_DECOMPRESSED).map_err(|e| {
-        Error::malformed(
-            path,
-            Location::Byte(e.offset),
-            format!(
-                "Unix compress (.Z) data: {} (or run `uncompress` on the file)",
-                e.reason
-            ),
-        )
-    })
+    source::read_all(path)
 }
 
 /// Summarizes a SegComp file read as `format` ([`Format::SegcompRange`],
