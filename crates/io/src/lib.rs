@@ -15,6 +15,16 @@
 //!   prints as `file:line: reason` or `file: byte N: reason`. No reader panics on any input;
 //!   property tests feed each one thousands of truncated and mutated files.
 //!
+//! ## Conventions
+//!
+//! Besides `open(path)`/`read_*(path)`, every reader has an in-memory entry point that takes
+//! the data first (a byte slice, or any `impl BufRead + Send + 'static` / `impl Read`, no boxing
+//! needed), then the name used in error messages, then options — as in
+//! [`kitti::parse_velodyne`]`(bytes, name)` and
+//! [`carmen::CarmenReader::with_config`]`(reader, name, config)`; writers likewise take the sink,
+//! the data, the name, then options. Errors print as `name:line: reason` for text and
+//! `name: byte N: reason` for binary data.
+//!
 //! ## Usage
 //!
 //! ```no_run

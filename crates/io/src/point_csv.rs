@@ -44,7 +44,7 @@ impl PointCsv {
     }
 
     /// Parses from `reader`; `name` is used in errors.
-    pub fn parse<R: BufRead + Send + 'static>(reader: R, name: impl Into<PathBuf>) -> Result<Self> {
+    pub fn parse(reader: impl BufRead + Send + 'static, name: impl Into<PathBuf>) -> Result<Self> {
         PointCsvReader::new(reader, name)?.read_all()
     }
 
@@ -113,8 +113,8 @@ impl PointCsvReader {
     }
 
     /// Reads from `reader` (header first); `name` is used in errors.
-    pub fn new<R: BufRead + Send + 'static>(reader: R, name: impl Into<PathBuf>) -> Result<Self> {
-        Self::from_lines(LineReader::new(name, Box::new(reader)))
+    pub fn new(reader: impl BufRead + Send + 'static, name: impl Into<PathBuf>) -> Result<Self> {
+        Self::from_lines(LineReader::new(reader, name))
     }
 
     fn from_lines(mut lines: LineReader) -> Result<Self> {

@@ -113,13 +113,18 @@ pub struct LineReader {
 impl LineReader {
     /// Opens `path` (decompressing if needed).
     pub fn open(path: &Path) -> Result<Self> {
-        Ok(Self::new(path, open(path)?))
+        Ok(Self::from_boxed(open(path)?, path))
     }
 
-    /// Reads from `reader`; `path` is used in error messages only.
-    pub fn new(path: impl Into<PathBuf>, reader: Box<dyn BufRead + Send>) -> Self {
+    /// Reads from `reader`; `name` is used in error messages only.
+    pub fn new(reader: impl BufRead + Send + 'static, name: impl Into<PathBuf>) -> Self {
+        Self::from_boxed(Box::new(reader), name)
+    }
+
+    /// Like [`LineReader::new`] for a reader that is boxed already (no second box).
+    fn from_boxed(reader: Box<dyn BufRead + Send>, name: impl Into<PathBuf>) -> Self {
         Self {
-            path: path.into(),
+            path: name.into(),
             reader,
             bytes: Vec::with_capacity(4096),
             text: String::with_capacity(4096),
@@ -212,10 +217,11 @@ macro_rules! read_number {
 }
 
 impl<R: Read> ByteReader<R> {
-    /// Reads from `reader`, whose first byte is at `offset` of the file `path`.
-    pub fn new(path: impl Into<PathBuf>, reader: R, offset: u64) -> Self {
+    /// Reads from `reader`, whose first byte is at `offset` of the source called `name`
+    /// (used in error messages only).
+    pub fn new(reader: R, name: impl Into<PathBuf>, offset: u64) -> Self {
         Self {
-            path: path.into(),
+            path: name.into(),
             reader,
             offset,
         }
@@ -348,7 +354,7 @@ mod tests {
 
     #[test]
     fn invalid_utf8_names_line() {
-        let mut lines = LineReader::new("x.txt", Box::new(Cursor::new(b"ok\nb\xffad\n".to_vec())));
+        let mut lines = LineReader::new(Cursor::new(b"ok\nb\xffad\n".to_vec()), "x.txt");
         lines.next_line().unwrap();
         let err = lines.next_line().unwrap_err().to_string();
         assert!(err.starts_with("x.txt:2: invalid UTF-8"), "{err}");
@@ -356,7 +362,7 @@ mod tests {
 
     #[test]
     fn truncated_binary_names_offset() {
-        let mut bytes = ByteReader::new("b.bin", Cursor::new(vec![1u8, 0, 0, 0, 7]), 0);
+        let mut bytes = ByteReader::new(Cursor::new(vec![1u8, 0, 0, 0, 7]), "b.bin", 0);
         assert_eq!(bytes.read_u32_le("count").unwrap(), 1);
         let err = bytes.read_u32_le("point x").unwrap_err().to_string();
         assert_eq!(

@@ -16,7 +16,7 @@
 //! ```
 //! use raypath_io::xyz::XyzReader;
 //! let text = "# a scan\n1 2 3\n4.5 -1 0.25 # with a comment\n";
-//! let mut reader = XyzReader::from_reader("mem.xyz", Box::new(text.as_bytes()));
+//! let mut reader = XyzReader::new(text.as_bytes(), "mem.xyz");
 //! let points: Vec<_> = reader.by_ref().collect::<Result<_, _>>()?;
 //! assert_eq!(points.len(), 2);
 //! assert_eq!(reader.columns(), Some(3));
@@ -49,8 +49,8 @@ impl XyzReader {
     }
 
     /// Reads from `reader`; `name` names the source in errors.
-    pub fn from_reader(name: impl Into<PathBuf>, reader: Box<dyn BufRead + Send>) -> Self {
-        Self::with_lines(LineReader::new(name, reader))
+    pub fn new(reader: impl BufRead + Send + 'static, name: impl Into<PathBuf>) -> Self {
+        Self::with_lines(LineReader::new(reader, name))
     }
 
     fn with_lines(lines: LineReader) -> Self {
@@ -149,10 +149,10 @@ pub fn read_xyz(path: &Path) -> Result<PointCloud> {
 
 /// Reads all points from `reader` into an unorganized cloud; `name` names it in errors.
 pub fn read_xyz_from(
+    reader: impl BufRead + Send + 'static,
     name: impl Into<PathBuf>,
-    reader: Box<dyn BufRead + Send>,
 ) -> Result<PointCloud> {
-    collect(XyzReader::from_reader(name, reader))
+    collect(XyzReader::new(reader, name))
 }
 
 fn collect(reader: XyzReader) -> Result<PointCloud> {

@@ -26,7 +26,7 @@ ROBOTLASER1 0 -1.0 2.0 1.0 81.9 0.01 1 3 5.0 81.91 6.0 3 100 200 300 1.0 0.0 0.0
 ";
 
 fn read(text: &str) -> Vec<Result<Record, Error>> {
-    CarmenReader::new("mem.log", Cursor::new(text.as_bytes().to_vec())).collect()
+    CarmenReader::new(Cursor::new(text.as_bytes().to_vec()), "mem.log").collect()
 }
 
 fn lasers(records: &[Result<Record, Error>]) -> Vec<&LaserMessage> {
@@ -182,7 +182,7 @@ fn log_with_code(scans: usize, code: &str) -> String {
 #[test]
 fn infers_the_no_return_code_in_the_lookahead() {
     let text = log_with_code(30, "81.91");
-    let reader = CarmenReader::new("code.log", Cursor::new(text.clone().into_bytes()));
+    let reader = CarmenReader::new(Cursor::new(text.clone().into_bytes()), "code.log");
     let estimate = reader.no_return(LaserKind::Front).unwrap();
     assert_eq!((estimate.code_m, estimate.code_count), (81.91, 30));
     let records: Vec<_> = reader.collect();
@@ -199,7 +199,7 @@ fn infers_the_no_return_code_in_the_lookahead() {
         ..CarmenConfig::default()
     };
     let reader =
-        CarmenReader::with_config("code.log", Cursor::new(text.into_bytes()), config).unwrap();
+        CarmenReader::with_config(Cursor::new(text.into_bytes()), "code.log", config).unwrap();
     assert_eq!(reader.no_return(LaserKind::Front), None);
     let records: Vec<_> = reader.collect();
     let scans = lasers(&records);
@@ -251,7 +251,7 @@ fn configuration_overrides() {
         ..CarmenConfig::default()
     };
     let reader =
-        CarmenReader::with_config("o.log", Cursor::new(text.as_bytes().to_vec()), config).unwrap();
+        CarmenReader::with_config(Cursor::new(text.as_bytes().to_vec()), "o.log", config).unwrap();
     let records: Vec<_> = reader.collect();
     let scan = &lasers(&records)[0].scan;
     assert_eq!((scan.angle_min_rad, scan.angle_increment_rad), (-0.2, 0.1));
@@ -265,7 +265,7 @@ fn configuration_overrides() {
     };
     let text = "FLASER 3 1 2 3 0 0 0 0 0 0 1 h 1\n";
     let reader =
-        CarmenReader::with_config("f.log", Cursor::new(text.as_bytes().to_vec()), config).unwrap();
+        CarmenReader::with_config(Cursor::new(text.as_bytes().to_vec()), "f.log", config).unwrap();
     let records: Vec<_> = reader.collect();
     let scan = &lasers(&records)[0].scan;
     assert!(close(scan.angle_min_rad, FRAC_PI_4));
@@ -275,7 +275,7 @@ fn configuration_overrides() {
         fov_rad: Some(4.0 * PI),
         ..CarmenConfig::default()
     };
-    let err = CarmenReader::with_config("b.log", Cursor::new(Vec::new()), bad)
+    let err = CarmenReader::with_config(Cursor::new(Vec::new()), "b.log", bad)
         .err()
         .unwrap();
     assert!(
@@ -295,7 +295,7 @@ fn malformed_lines_are_reported_and_skipped() {
     // Line 3 is not UTF-8.
     let bad = bytes.iter().position(|&b| b == 0).unwrap();
     bytes[bad] = 0xff;
-    let records: Vec<_> = CarmenReader::new("bad.log", Cursor::new(bytes)).collect();
+    let records: Vec<_> = CarmenReader::new(Cursor::new(bytes), "bad.log").collect();
     assert_eq!(records.len(), 5, "{records:?}");
     let err = records[0].as_ref().unwrap_err();
     assert_eq!(err.location(), Location::Line(1));

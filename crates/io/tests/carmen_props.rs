@@ -96,7 +96,7 @@ fn check(bytes: Vec<u8>, lookahead_scans: usize) {
         lookahead_scans,
         ..CarmenConfig::default()
     };
-    let reader = CarmenReader::with_config("fuzz.log", Cursor::new(bytes), config).unwrap();
+    let reader = CarmenReader::with_config(Cursor::new(bytes), "fuzz.log", config).unwrap();
     for record in reader {
         match record {
             Ok(Record::Laser(laser)) => {
@@ -137,7 +137,7 @@ proptest! {
 
 #[test]
 fn the_unmutated_log_reads_cleanly() {
-    let records: Vec<_> = CarmenReader::new("ok.log", Cursor::new(LOG.as_bytes().to_vec()))
+    let records: Vec<_> = CarmenReader::new(Cursor::new(LOG.as_bytes().to_vec()), "ok.log")
         .collect::<Result<_, _>>()
         .unwrap();
     assert_eq!(records.len(), 10);

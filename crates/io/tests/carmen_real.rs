@@ -144,7 +144,7 @@ fn lookahead_inference_agrees_with_the_two_pass_inference() {
         let Some(path) = corrected(log) else { continue };
         let two_pass = CarmenReader::open(&path).unwrap();
         let stream = raypath_io::source::open(&path).unwrap();
-        let lookahead = CarmenReader::new(&path, stream);
+        let lookahead = CarmenReader::new(stream, &path);
         let (a, b) = (
             two_pass.no_return(LaserKind::Front).unwrap(),
             lookahead.no_return(LaserKind::Front).unwrap(),

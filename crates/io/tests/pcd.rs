@@ -9,7 +9,7 @@ use raypath_io::{Location, summarize};
 
 fn write(cloud: &PointCloud, options: &WriteOptions) -> Vec<u8> {
     let mut bytes = Vec::new();
-    pcd::write_pcd_to(&mut bytes, "mem.pcd".as_ref(), cloud, options).unwrap();
+    pcd::write_pcd_to(&mut bytes, cloud, "mem.pcd".as_ref(), options).unwrap();
     bytes
 }
 
@@ -180,8 +180,8 @@ fn writer_rejects_inconsistent_clouds() {
     let mut bytes = Vec::new();
     let err = pcd::write_pcd_to(
         &mut bytes,
-        "w.pcd".as_ref(),
         &cloud,
+        "w.pcd".as_ref(),
         &WriteOptions::new(DataEncoding::Binary),
     )
     .unwrap_err();

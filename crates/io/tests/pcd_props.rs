@@ -31,8 +31,8 @@ fn bases() -> Vec<Vec<u8>> {
             let mut bytes = Vec::new();
             pcd::write_pcd_to(
                 &mut bytes,
-                "p.pcd".as_ref(),
                 &cloud,
+                "p.pcd".as_ref(),
                 &WriteOptions::new(encoding),
             )
             .unwrap();

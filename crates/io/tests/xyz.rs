@@ -9,16 +9,13 @@ use raypath_io::xyz::{self, XyzReader};
 use raypath_io::{Format, Location, summarize};
 
 fn reader(text: &str) -> XyzReader {
-    XyzReader::from_reader(
-        "t.xyz",
-        Box::new(std::io::Cursor::new(text.as_bytes().to_vec())),
-    )
+    XyzReader::new(std::io::Cursor::new(text.as_bytes().to_vec()), "t.xyz")
 }
 
 #[test]
 fn reads_points_comments_and_extra_columns() {
     let text = "# header\n\n1 2 3 0.5\n  -4\t5e-1 6 7 # note\n";
-    let cloud = xyz::read_xyz_from("t.xyz", Box::new(text.as_bytes())).unwrap();
+    let cloud = xyz::read_xyz_from(text.as_bytes(), "t.xyz").unwrap();
     assert_eq!(
         cloud.points,
         vec![Point3::new(1.0, 2.0, 3.0), Point3::new(-4.0, 0.5, 6.0)]
@@ -128,7 +125,7 @@ proptest! {
                 bytes[i] = v;
             }
         }
-        let result = xyz::read_xyz_from("m.xyz", Box::new(std::io::Cursor::new(bytes)));
+        let result = xyz::read_xyz_from(std::io::Cursor::new(bytes), "m.xyz");
         if let Ok(cloud) = result {
             prop_assert!(cloud.points.iter().all(|p| p.iter().all(|v| v.is_finite())));
         }

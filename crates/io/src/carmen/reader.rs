@@ -105,8 +105,8 @@ impl CarmenReader {
 
     /// Reads a log from `reader` (already decompressed) with the default configuration;
     /// `name` is used in error messages.
-    pub fn new(name: impl Into<PathBuf>, reader: impl BufRead + Send + 'static) -> Self {
-        let lines = LineReader::new(name, Box::new(reader));
+    pub fn new(reader: impl BufRead + Send + 'static, name: impl Into<PathBuf>) -> Self {
+        let lines = LineReader::new(reader, name);
         Self::lookahead(lines, CarmenConfig::default())
     }
 
@@ -115,16 +115,13 @@ impl CarmenReader {
     /// 100 lines per look-ahead scan in all) are read and kept now to infer the no-return
     /// code.
     pub fn with_config(
-        name: impl Into<PathBuf>,
         reader: impl BufRead + Send + 'static,
+        name: impl Into<PathBuf>,
         config: CarmenConfig,
     ) -> Result<Self> {
         let name = name.into();
         config.validate(&name)?;
-        Ok(Self::lookahead(
-            LineReader::new(name, Box::new(reader)),
-            config,
-        ))
+        Ok(Self::lookahead(LineReader::new(reader, name), config))
     }
 
     fn lookahead(mut lines: LineReader, config: CarmenConfig) -> Self {

@@ -72,11 +72,11 @@ pub fn read_calib(path: &Path) -> Result<KittiCalib> {
 }
 
 /// Parses a calibration file from `reader`; `name` is used in errors.
-pub fn parse_calib<R: BufRead + Send + 'static>(
-    reader: R,
+pub fn parse_calib(
+    reader: impl BufRead + Send + 'static,
     name: impl Into<PathBuf>,
 ) -> Result<KittiCalib> {
-    calib_from(LineReader::new(name, Box::new(reader)))
+    calib_from(LineReader::new(reader, name))
 }
 
 /// Number of values a known key must have.

@@ -20,11 +20,11 @@ pub fn read_poses(path: &Path) -> Result<Vec<Pose3>> {
 }
 
 /// Parses poses from `reader`; `name` is used in errors.
-pub fn parse_poses<R: BufRead + Send + 'static>(
-    reader: R,
+pub fn parse_poses(
+    reader: impl BufRead + Send + 'static,
     name: impl Into<PathBuf>,
 ) -> Result<Vec<Pose3>> {
-    poses_from(LineReader::new(name, Box::new(reader)))
+    poses_from(LineReader::new(reader, name))
 }
 
 fn poses_from(mut lines: LineReader) -> Result<Vec<Pose3>> {
@@ -70,11 +70,11 @@ pub fn read_times(path: &Path) -> Result<Vec<f64>> {
 }
 
 /// Parses timestamps from `reader`; `name` is used in errors.
-pub fn parse_times<R: BufRead + Send + 'static>(
-    reader: R,
+pub fn parse_times(
+    reader: impl BufRead + Send + 'static,
     name: impl Into<PathBuf>,
 ) -> Result<Vec<f64>> {
-    times_from(LineReader::new(name, Box::new(reader)))
+    times_from(LineReader::new(reader, name))
 }
 
 fn times_from(mut lines: LineReader) -> Result<Vec<f64>> {

@@ -110,8 +110,8 @@ pub fn read_pose_csv(path: &Path) -> Result<PoseTable> {
 }
 
 /// Parses a pose CSV from `reader`; `name` is used in errors.
-pub fn parse_pose_csv<R: BufRead + Send + 'static>(
-    reader: R,
+pub fn parse_pose_csv(
+    reader: impl BufRead + Send + 'static,
     name: impl Into<PathBuf>,
 ) -> Result<PoseTable> {
     PoseCsvReader::new(reader, name).read_all()
@@ -123,8 +123,8 @@ pub fn read_covariance(path: &Path) -> Result<CovarianceTable> {
 }
 
 /// Parses a covariance CSV from `reader`; `name` is used in errors.
-pub fn parse_covariance<R: BufRead + Send + 'static>(
-    reader: R,
+pub fn parse_covariance(
+    reader: impl BufRead + Send + 'static,
     name: impl Into<PathBuf>,
 ) -> Result<CovarianceTable> {
     CovarianceReader::new(reader, name).read_all()
@@ -140,8 +140,8 @@ impl PoseCsvReader {
     }
 
     /// Reads from `reader`; `name` is used in errors.
-    pub fn new<R: BufRead + Send + 'static>(reader: R, name: impl Into<PathBuf>) -> Self {
-        Self(Rows::new(LineReader::new(name, Box::new(reader))))
+    pub fn new(reader: impl BufRead + Send + 'static, name: impl Into<PathBuf>) -> Self {
+        Self(Rows::new(LineReader::new(reader, name)))
     }
 
     /// Rows skipped so far because they contain NaN.
@@ -186,8 +186,8 @@ impl CovarianceReader {
     }
 
     /// Reads from `reader`; `name` is used in errors.
-    pub fn new<R: BufRead + Send + 'static>(reader: R, name: impl Into<PathBuf>) -> Self {
-        Self(Rows::new(LineReader::new(name, Box::new(reader))))
+    pub fn new(reader: impl BufRead + Send + 'static, name: impl Into<PathBuf>) -> Self {
+        Self(Rows::new(LineReader::new(reader, name)))
     }
 
     /// Reads all remaining rows.

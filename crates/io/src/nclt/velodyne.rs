@@ -161,7 +161,7 @@ impl<R: BufRead> HitsReader<R> {
     /// known) checks hit counts before anything is allocated.
     pub fn new(reader: R, name: impl Into<PathBuf>, len: Option<u64>) -> Self {
         Self {
-            bytes: ByteReader::new(name, reader, 0),
+            bytes: ByteReader::new(reader, name, 0),
             len,
             failed: false,
         }

@@ -161,7 +161,7 @@ impl<R: BufRead> BtReader<R> {
     pub fn new(mut reader: R, name: impl Into<PathBuf>) -> Result<Self> {
         let name = name.into();
         let header = read_header(&mut reader, &name)?;
-        let mut bytes = ByteReader::new(name, reader, header.data_offset);
+        let mut bytes = ByteReader::new(reader, name, header.data_offset);
         let mut stack = Vec::with_capacity(usize::from(TREE_DEPTH));
         let (mut nodes, mut inner_nodes) = (0, 0);
         if header.size > 0 {

@@ -135,7 +135,7 @@ impl<R: BufRead> ScanGraphReader<R> {
     /// Reads from `reader`; `name` is used in errors and `len`, the number of bytes of the
     /// input when known, guards counts read from the file before anything is allocated.
     pub fn new(reader: R, name: impl Into<PathBuf>, len: Option<u64>) -> Result<Self> {
-        let mut bytes = ByteReader::new(name, reader, 0);
+        let mut bytes = ByteReader::new(reader, name, 0);
         let num_nodes = bytes.read_u32_le("node count")?;
         // Each node holds at least a point count, a pose and an id.
         let min_node = 4 + 28 + 36 + 4;

@@ -44,7 +44,7 @@
 //! assert_eq!(read.cloud.num_valid(), 1);
 //! let mut bytes = Vec::new();
 //! let options = pcd::WriteOptions::new(DataEncoding::BinaryCompressed);
-//! pcd::write_pcd_to(&mut bytes, "out.pcd".as_ref(), &read.cloud, &options)?;
+//! pcd::write_pcd_to(&mut bytes, &read.cloud, "out.pcd".as_ref(), &options)?;
 //! # Ok::<(), raypath_io::Error>(())
 //! ```
 

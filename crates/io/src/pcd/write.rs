@@ -43,7 +43,7 @@ pub fn write_pcd(path: &Path, cloud: &PointCloud, encoding: DataEncoding) -> Res
 pub fn write_pcd_with(path: &Path, cloud: &PointCloud, options: &WriteOptions) -> Result<()> {
     let file = File::create(path).map_err(|e| Error::io(path, Location::File, e))?;
     let mut writer = BufWriter::new(file);
-    write_pcd_to(&mut writer, path, cloud, options)?;
+    write_pcd_to(&mut writer, cloud, path, options)?;
     writer
         .flush()
         .map_err(|e| Error::io(path, Location::File, e))
@@ -51,9 +51,9 @@ pub fn write_pcd_with(path: &Path, cloud: &PointCloud, options: &WriteOptions) -
 
 /// Writes `cloud` to `writer`; `name` names the destination in errors.
 pub fn write_pcd_to(
-    writer: &mut dyn Write,
-    name: &Path,
+    mut writer: impl Write,
     cloud: &PointCloud,
+    name: &Path,
     options: &WriteOptions,
 ) -> Result<()> {
     cloud.validate().map_err(|e| Error::Unwritable {
@@ -65,7 +65,7 @@ pub fn write_pcd_to(
         .write_all(header_text(cloud, options).as_bytes())
         .map_err(io)?;
     match options.encoding {
-        DataEncoding::Ascii => write_ascii(writer, cloud).map_err(io),
+        DataEncoding::Ascii => write_ascii(&mut writer, cloud).map_err(io),
         DataEncoding::Binary => writer.write_all(&binary_points(cloud)).map_err(io),
         DataEncoding::BinaryCompressed => {
             let raw = columns(cloud);

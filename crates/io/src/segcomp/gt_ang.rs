@@ -55,7 +55,7 @@ pub fn parse_gt_ang(
     reader: impl BufRead + Send + 'static,
     name: impl Into<PathBuf>,
 ) -> Result<GroundTruthAngles> {
-    let mut lines = LineReader::new(name, Box::new(reader));
+    let mut lines = LineReader::new(reader, name);
     let count = loop {
         let Some(line) = lines.next_line()? else {
             return Err(crate::Error::truncated(
