@@ -11,8 +11,10 @@
 //!   of threads ([`rng::stream`] gives every work item its own random stream).
 //! * **Parallel** with rayon at the outer level (scans, rows of rays).
 
+mod dataset;
 mod error;
 pub mod rng;
 pub mod scene3;
 
+pub use dataset::{GeneratedSet, Progress, no_progress};
 pub use error::{Result, SimError};
