@@ -20,6 +20,9 @@
 //!
 //! Other messages (`NEFF`, `TRUEPOS`, `SYNC`, `RAWLASER1`, …) become [`Record::Other`].
 //!
+//! [`CarmenWriter`] writes the same messages (deterministic number formatting, see
+//! [`NumberFormat`]); a log written and read back gives the records that were written.
+//!
 //! **Units and frames.** Metres, radians and seconds; poses are `(x, y, θ)` with θ
 //! counter-clockwise (REP-103: x forward, y left). The laser pose `x y theta` is
 //! [`LaserMessage::world_from_laser`]; in the `*-corrected` logs it is the SLAM-corrected
@@ -60,9 +63,11 @@ mod parse;
 mod reader;
 mod record;
 mod summarize;
+mod write;
 
 pub use config::{CarmenConfig, FanConvention, NoReturnRange};
 pub use no_return::{NoReturnEstimate, NoReturnHistogram};
 pub use reader::CarmenReader;
 pub use record::{LaserKind, LaserMessage, OdometryMessage, Record, RobotLaserInfo, Velocities};
 pub use summarize::summarize;
+pub use write::{CarmenWriter, Decimals, NumberFormat};
