@@ -23,6 +23,8 @@
 //!
 //! [`KittiSequence::open`] finds the files of one sequence, both in the benchmark layout and
 //! with everything in one directory (`poses.txt`, `times.txt`, `calib.txt`, `velodyne/`).
+//! Writers ([`write_velodyne`], [`write_poses`], [`write_times`], [`write_calib`],
+//! [`KittiLayout`]) produce the same files with fixed number formatting.
 //!
 //! [`PointCloud::intensity`]: raypath_geometry::PointCloud::intensity
 
@@ -30,6 +32,7 @@ mod calib;
 mod poses;
 mod sequence;
 mod velodyne;
+mod write;
 
 use std::path::Path;
 
@@ -44,6 +47,11 @@ pub use poses::{
 };
 pub use sequence::{KittiScan, KittiScans, KittiSequence, ScanFile};
 pub use velodyne::{VELODYNE_POINT_BYTES, parse_velodyne, read_velodyne, velodyne_point_count};
+pub use write::{
+    KittiLayout, cam0_poses_from_velodyne, encode_velodyne, velodyne_poses_from_cam0, write_calib,
+    write_calib_to, write_poses, write_poses_to, write_times, write_times_to, write_velodyne,
+};
+pub(crate) use write::{push_exp, write_file};
 
 /// Summarizes a KITTI sequence directory or one of its files, read as `format`.
 pub fn summarize(path: &Path, format: Format) -> Result<Summary> {

@@ -35,12 +35,16 @@
 //! laser ids (0–31) are kept in [`PointCloud::label`], intensities (0–255) in
 //! [`PointCloud::intensity`].
 //!
+//! Writers ([`write_velodyne_sync`], [`write_pose_csv`], [`write_covariance_csv`],
+//! [`NcltLayout`]) produce the same files; see their module for the encoding rules.
+//!
 //! [`PointCloud::label`]: raypath_geometry::PointCloud::label
 //! [`PointCloud::intensity`]: raypath_geometry::PointCloud::intensity
 
 mod csv;
 mod session;
 mod velodyne;
+mod write;
 
 use std::path::Path;
 
@@ -58,6 +62,10 @@ pub use velodyne::{
     HITS_HEADER_BYTES, HITS_MAGIC, HitsHeader, HitsPacket, HitsReader, MAX_HITS_PER_PACKET,
     OFFSET_M, RECORD_BYTES, SCALE_M, decode_coordinate, flu_from_frd, parse_velodyne_sync,
     read_velodyne_sync, utime_from_path,
+};
+pub use write::{
+    NcltLayout, encode_coordinate, encode_velodyne_sync, write_covariance_csv,
+    write_covariance_csv_to, write_pose_csv, write_pose_csv_to, write_velodyne_sync,
 };
 
 /// `T_wo` of the reference implementation: NED world axes to ENU (x east, y north, z up).
