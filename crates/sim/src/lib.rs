@@ -14,6 +14,7 @@
 mod dataset;
 mod error;
 pub mod rng;
+pub mod scene2;
 pub mod scene3;
 
 pub use dataset::{GeneratedSet, Progress, no_progress};
