@@ -13,6 +13,7 @@
 
 mod dataset;
 mod error;
+pub mod lidar3;
 pub mod rng;
 pub mod scene2;
 pub mod scene3;
