@@ -14,6 +14,8 @@
 mod dataset;
 mod error;
 pub mod lidar3;
+mod out2d;
+pub mod polygons;
 pub mod rng;
 pub mod scene2;
 pub mod scene3;
