@@ -11,6 +11,7 @@
 //!   of threads ([`rng::stream`] gives every work item its own random stream).
 //! * **Parallel** with rayon at the outer level (scans, rows of rays).
 
+pub mod corridor;
 mod dataset;
 mod error;
 pub mod lidar3;
