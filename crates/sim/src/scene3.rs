@@ -1,5 +1,8 @@
 //! 3-D scenes: a triangle soup in one BVH, every triangle tagged with the surface it belongs
 //! to, for exact first-hit ray casting with parry3d (f64).
+//!
+//! Solids: polygons, boxes, cylinders (plain or with separate caps), prisms, wedges, stairs and
+//! spheres ([`SceneBuilder3::add_prism`] and friends).
 
 use nalgebra::{Point3, Unit, Vector3};
 use parry3d_f64::query::{Ray, RayCast};
@@ -7,6 +10,8 @@ use parry3d_f64::shape::{FeatureId, TriMesh};
 use raypath_geometry::{Aabb3, Pose3};
 
 use crate::error::{Result, SimError};
+
+mod primitives;
 
 /// Index of a [`Surface`] in a scene.
 pub type SurfaceId = u32;
@@ -130,24 +135,7 @@ impl SceneBuilder3 {
         segments: usize,
         surface: SurfaceId,
     ) {
-        let n = segments.max(3);
-        let ring = |z: f64| -> Vec<Point3<f64>> {
-            (0..n)
-                .map(|i| {
-                    let a = std::f64::consts::TAU * i as f64 / n as f64;
-                    base_center + Vector3::new(radius_m * a.cos(), radius_m * a.sin(), z)
-                })
-                .collect()
-        };
-        let (bottom, top) = (ring(0.0), ring(height_m));
-        for i in 0..n {
-            let j = (i + 1) % n;
-            self.add_polygon(&[bottom[i], bottom[j], top[j], top[i]], surface);
-        }
-        let mut bottom_rev = bottom.clone();
-        bottom_rev.reverse();
-        self.add_polygon(&bottom_rev, surface);
-        self.add_polygon(&top, surface);
+        self.add_capped_cylinder(base_center, radius_m, height_m, segments, [surface; 3]);
     }
 
     /// Builds the BVH. Fails for a scene without triangles.
