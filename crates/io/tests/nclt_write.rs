@@ -178,3 +178,18 @@ fn a_written_session_is_discovered_and_summarized() {
     assert_eq!(summary.poses, Some(2));
     assert_eq!(summary.odometry, Some(2));
 }
+
+#[test]
+fn values_rounding_to_zero_have_no_sign() {
+    let rows = [NcltPose {
+        utime: 5,
+        xyz: [-1e-9, -0.0, 2.0],
+        rpy: [-1e-12, 0.0, -0.25],
+    }];
+    let mut bytes = Vec::new();
+    write_pose_csv_to(&mut bytes, &rows, name()).unwrap();
+    assert_eq!(
+        String::from_utf8(bytes).unwrap(),
+        "5,0.000000,0.000000,2.000000,0.000000000,0.000000000,-0.250000000\n"
+    );
+}

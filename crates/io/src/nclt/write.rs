@@ -9,8 +9,8 @@
 //!   Points are written as given, in the stored velodyne frame (x forward, y right, z down):
 //!   apply [`flu_from_frd`](super::flu_from_frd) (its own inverse) to a REP-103 cloud first.
 //! * **CSV rows** have no header: `utime` as an integer, positions with 6 decimals (µm),
-//!   angles with 9 decimals (nrad), covariance entries in C `%.9e` style. Negative zero is
-//!   written as zero.
+//!   angles with 9 decimals (nrad), covariance entries in C `%.9e` style. Values that round to
+//!   zero are written without a sign (no `-0.000000`).
 //!
 //! [`NcltPose::from_world_from_body`] converts a REP-103 pose to the stored NED convention
 //! (the exact inverse of [`NcltPose::world_from_body`]), and [`NcltPose::from_increment`] a
@@ -128,7 +128,7 @@ pub fn write_pose_csv_to(mut writer: impl Write, poses: &[NcltPose], name: &Path
             } else {
                 ANGLE_DECIMALS
             };
-            let _ = write!(line, ",{:.decimals$}", v + 0.0);
+            push_fixed(&mut line, *v, decimals);
         }
         line.push('\n');
         writer
@@ -136,6 +136,17 @@ pub fn write_pose_csv_to(mut writer: impl Write, poses: &[NcltPose], name: &Path
             .map_err(|e| Error::io(name, Location::File, e))?;
     }
     Ok(())
+}
+
+/// Appends `,` and `value` with `decimals` decimals; values that round to zero are written
+/// without a sign.
+fn push_fixed(line: &mut String, value: f64, decimals: usize) {
+    let start = line.len() + 1;
+    let _ = write!(line, ",{value:.decimals$}");
+    let written = line.get(start..).unwrap_or_default();
+    if written.starts_with('-') && written.bytes().all(|b| matches!(b, b'-' | b'0' | b'.')) {
+        line.remove(start);
+    }
 }
 
 /// Writes a pose CSV ([`write_pose_csv_to`]).
