@@ -20,6 +20,7 @@ pub mod polygons;
 pub mod rng;
 pub mod scene2;
 pub mod scene3;
+pub mod urban;
 
 pub use dataset::{GeneratedSet, Progress, no_progress};
 pub use error::{Result, SimError};
