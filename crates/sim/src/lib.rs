@@ -14,6 +14,7 @@
 pub mod corridor;
 mod dataset;
 mod error;
+pub mod indoor;
 pub mod lidar3;
 mod out2d;
 pub mod polygons;

@@ -6,7 +6,7 @@
 //! follow REP-103 (x forward, y left, angles counter-clockwise), units are metres.
 
 use nalgebra::{Point2, Unit, Vector2};
-use parry2d_f64::query::Ray;
+use parry2d_f64::query::{PointQuery, Ray};
 use parry2d_f64::shape::{CompositeShapeRef, Polyline};
 use raypath_geometry::{Aabb2, Pose2};
 
@@ -221,6 +221,12 @@ impl Scene2 {
         }
         let direction = Unit::new_unchecked(d / length);
         self.cast(a, &direction, length).is_none()
+    }
+
+    /// Distance in metres from `point` to the nearest segment.
+    pub fn distance(&self, point: &Point2<f64>) -> f64 {
+        let projection = self.polyline.project_local_point(point, false);
+        (projection.point - point).norm()
     }
 
     /// The end points of segment `i`.

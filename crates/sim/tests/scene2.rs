@@ -47,6 +47,10 @@ fn single_segment_hits_and_misses() {
     assert!(scene.cast(&origin, &dir(PI), 10.0).is_none());
     assert!(!scene.is_free(&origin, &Point2::new(3.0, 0.0)));
     assert!(scene.is_free(&origin, &Point2::new(1.9, 0.0)));
+    // Distances: to the segment's interior and to its end points.
+    assert!((scene.distance(&origin) - 2.0).abs() < 1e-12);
+    assert!((scene.distance(&Point2::new(2.0, 4.0)) - 3.0).abs() < 1e-12);
+    assert!((scene.distance(&Point2::new(5.0, -5.0)) - 5.0).abs() < 1e-12);
 }
 
 #[test]
