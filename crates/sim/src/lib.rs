@@ -21,6 +21,7 @@ pub mod polygons;
 pub mod rng;
 pub mod scene2;
 pub mod scene3;
+pub mod semi_kitti;
 pub mod urban;
 
 pub use dataset::{GeneratedSet, Progress, no_progress};

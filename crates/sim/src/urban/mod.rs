@@ -37,6 +37,7 @@
 //! `poles.csv` (`x,y,w,h,kind,id`, see [`output::POLES_HEADER`]). Surfaces carry SemanticKITTI
 //! labels ([`kinds::label`]) with the pole id + 1 as instance on poles and what they carry.
 
+pub mod along_path;
 pub mod kinds;
 pub mod kitti_out;
 mod kitti_set;
