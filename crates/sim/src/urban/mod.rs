@@ -38,6 +38,7 @@
 //! labels ([`kinds::label`]) with the pole id + 1 as instance on poles and what they carry.
 
 pub mod along_path;
+mod furniture;
 pub mod kinds;
 pub mod kitti_out;
 mod kitti_set;
@@ -45,6 +46,8 @@ pub mod mesh;
 pub mod nclt_set;
 pub mod odometry;
 pub mod output;
+mod path_index;
+mod roadside;
 pub mod route;
 pub mod sessions;
 pub mod streets;
