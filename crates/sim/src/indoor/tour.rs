@@ -129,8 +129,8 @@ fn drive_lap<R: Rng + ?Sized>(
     reached
 }
 
-/// A goal in `room`: the reachable cell with clearance ≥ 0.6 m (else the freest reachable
-/// cell) nearest a random point of the room.
+/// A goal in `room`: the reachable cell with clearance ≥ 0.6 m (else any reachable cell) of
+/// the room nearest a random point 2–3.5 m inside its corridor door.
 fn room_goal<R: Rng + ?Sized>(
     world: &World,
     grid: &planner::ClearanceGrid,
@@ -139,10 +139,39 @@ fn room_goal<R: Rng + ?Sized>(
     rng: &mut R,
 ) -> Option<Point2<f64>> {
     let s = world.spaces.get(room)?;
-    let target = Point2::new(
-        s.min[0] + rng.random::<f64>() * (s.max[0] - s.min[0]),
-        s.min[1] + rng.random::<f64>() * (s.max[1] - s.min[1]),
+    // Near the room's door to a corridor (2–3.5 m in, from where the laser sees the room
+    // when the robot looks around), else anywhere in the room.
+    let door = world.doors.iter().find(|d| {
+        d.spaces.contains(&room)
+            && d.spaces.iter().any(|&j| {
+                world
+                    .spaces
+                    .get(j)
+                    .is_some_and(|x| x.kind == SpaceKind::Corridor)
+            })
+    });
+    let (u, v, depth) = (
+        rng.random::<f64>(),
+        rng.random::<f64>(),
+        rng.random_range(2.0..3.5),
     );
+    let target = match door {
+        Some(d) => {
+            let c = Point2::new(d.center[0], d.center[1]);
+            let inward = (s.center() - c).normalize();
+            let inward = if d.horizontal_wall {
+                nalgebra::Vector2::new(0.0, inward.y.signum())
+            } else {
+                nalgebra::Vector2::new(inward.x.signum(), 0.0)
+            };
+            let lateral = nalgebra::Vector2::new(-inward.y, inward.x) * (u - 0.5) * 2.0;
+            c + inward * depth + lateral
+        }
+        None => Point2::new(
+            s.min[0] + u * (s.max[0] - s.min[0]),
+            s.min[1] + v * (s.max[1] - s.min[1]),
+        ),
+    };
     let inside =
         |p: &Point2<f64>| p.x > s.min[0] && p.x < s.max[0] && p.y > s.min[1] && p.y < s.max[1];
     let candidates: Vec<usize> = (0..grid.len())
