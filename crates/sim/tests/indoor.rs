@@ -225,8 +225,12 @@ fn check_motion(world: &WorldConfig, run: &WorldRun) {
             assert!((b.v - a.v).abs() / dt <= robot.max_accel_mps2 * 1.001 + 1e-9);
             assert!((b.theta - a.theta).abs() / dt <= robot.max_turn_rate_radps * 1.001 + 1e-9);
         }
-        // Continuous motion: keyframes are close.
-        assert!(ds < 0.011 && (b.theta - a.theta).abs() < 0.05);
+        // Continuous motion: keyframes are close (1 cm of arc turns by at most 0.1 rad on the
+        // smallest, 10 cm fillet).
+        assert!(
+            ds < 0.011 && (b.theta - a.theta).abs() < 0.101,
+            "{a:?} {b:?}"
+        );
     }
     // Collision-free with a margin: the robot's disc never touches anything (tables included).
     let clearance = states
