@@ -21,6 +21,7 @@ pub mod polygons;
 pub mod rng;
 pub mod scene2;
 pub mod scene3;
+pub mod synpeb;
 pub mod semi_kitti;
 pub mod urban;
 

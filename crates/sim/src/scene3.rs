@@ -13,6 +13,8 @@ use crate::error::{Result, SimError};
 
 mod primitives;
 
+pub(crate) use primitives::is_convex_ccw;
+
 /// Index of a [`Surface`] in a scene.
 pub type SurfaceId = u32;
 
