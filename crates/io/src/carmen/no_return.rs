@@ -18,7 +18,12 @@
 //!    error codes just below the no-return code, for example 81.83 m besides 81.91 m);
 //! 3. the code is the most frequent cluster member (the higher one on a tie), and the
 //!    **threshold** is the lowest member: readings at or above it are no-returns
-//!    ([`raypath_geometry::Scan2::max_range_m`]).
+//!    ([`raypath_geometry::Scan2::max_range_m`]);
+//! 4. the cluster is accepted only when almost nothing lies above it: at most
+//!    `max(10, cluster / 100)` readings. A no-return code is the top of a log's range
+//!    distribution; a repeated value with many readings above it is a real range (for example
+//!    a near-circular room scanned from its centre), and treating it as a code would throw away
+//!    every reading above it. On the Radish logs at most 2 readings lie above the cluster.
 //!
 //! A log without a repeated value has no code; the reader then falls back to what the log or
 //! the configuration states (see [`crate::carmen::NoReturnRange`]). Real ranges are never
@@ -42,6 +47,10 @@ const MAX_GAP_CM: i64 = 10;
 const MIN_REPEATS: u64 = 10;
 /// … and at least once per this many readings.
 const READINGS_PER_REPEAT: u64 = 20_000;
+/// At most this many readings may lie above an accepted cluster …
+const MAX_ABOVE: u64 = 10;
+/// … or one per this many cluster readings, whichever is larger.
+const CLUSTER_PER_ABOVE: u64 = 100;
 
 /// The inferred no-return encoding of a log.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -97,6 +106,7 @@ impl NoReturnHistogram {
         let mut values: Vec<(i64, u64)> = self.counts.iter().map(|(&v, &n)| (v, n)).collect();
         values.sort_unstable_by_key(|&(value, _)| std::cmp::Reverse(value));
         let top = values.iter().position(|&(_, n)| n >= min_repeats)?;
+        let above: u64 = values.get(..top)?.iter().map(|&(_, n)| n).sum();
         let mut code = values.get(top).copied()?;
         let mut lowest = code.0;
         let mut cluster_count = 0;
@@ -109,6 +119,9 @@ impl NoReturnHistogram {
             if count > code.1 {
                 code = (value, count);
             }
+        }
+        if above > MAX_ABOVE.max(cluster_count / CLUSTER_PER_ABOVE) {
+            return None;
         }
         Some(NoReturnEstimate {
             code_m: code.0 as f64 / 100.0,
@@ -131,6 +144,19 @@ mod tests {
             }
         }
         h
+    }
+
+    #[test]
+    fn repeated_real_range_with_readings_above_is_not_a_code() {
+        // A near-circular room: one range repeats, but hundreds of readings lie above it.
+        let mut pairs: Vec<(f64, u64)> =
+            (0..900).map(|i| (12.62 + f64::from(i) * 0.01, 1)).collect();
+        pairs.push((12.61, 12));
+        pairs.push((5.0, 3000));
+        assert!(histogram(&pairs).estimate().is_none());
+        // A real code with a couple of stray readings above it is still found.
+        let h = histogram(&[(81.91, 5000), (82.5, 2), (3.0, 500)]);
+        assert_eq!(h.estimate().unwrap().code_m, 81.91);
     }
 
     #[test]
