@@ -4,6 +4,9 @@
 //! * `street/hdl64e`: an HDL-64E (64 × 2083 beams) 1.73 m above a 200 m street built here from
 //!   boxes and cylinders: road and sidewalks, facades of varying height on both sides, poles,
 //!   tree trunks with box canopies and parked cars (body + cabin).
+//! * `urban/hdl64e`: an HDL-64E 1.73 m above the road in the middle of a street of the
+//!   procedural urban world (`raypath_sim::urban`, default 5 × 4 blocks, one session: buildings,
+//!   poles, trees with canopies, parked cars, fences) — the workload of the KITTI-style sets.
 //! * `synpeb/500x500`: the organized 500 × 500 scanner of the SynPEB-style generator in one of
 //!   its rooms (≈ 6 × 7 × 3 m with polyhedral objects).
 //!
@@ -20,6 +23,8 @@ use raypath_geometry::Pose3;
 use raypath_sim::lidar3::Lidar3;
 use raypath_sim::scene3::{Scene3, SceneBuilder3, Surface};
 use raypath_sim::synpeb::{self, SynpebConfig};
+use raypath_sim::urban::sessions::session_worlds;
+use raypath_sim::urban::{StreetConfig, generate_layout};
 
 /// A straight 200 m street along x: road, sidewalks, facades, poles, trees and parked cars.
 fn street_scene() -> Scene3 {
@@ -126,6 +131,30 @@ fn bench_rays(c: &mut Criterion) {
     group.bench_function(
         format!("street/hdl64e/{}-threads", rayon::current_num_threads()),
         |b| b.iter(|| black_box(hdl64e.scan(&street, &pose, 1, 0))),
+    );
+
+    let layout = generate_layout(&StreetConfig::default(), 2020).expect("a street world");
+    let (world, _) = session_worlds(&layout, &[9], &Default::default(), 2020)
+        .into_iter()
+        .next()
+        .expect("a session");
+    let urban = world.build_scene().expect("the urban scene");
+    let grid = &layout.grid;
+    let urban_pose = Pose3::from_xyz_rpy(
+        grid.xs[2] - 1.5,
+        (grid.ys[1] + grid.ys[2]) / 2.0,
+        1.73,
+        0.0,
+        0.0,
+        std::f64::consts::FRAC_PI_2,
+    );
+    group.throughput(Throughput::Elements(hdl64e.num_rays() as u64));
+    group.bench_function("urban/hdl64e/1-thread", |b| {
+        b.iter(|| one_thread.install(|| black_box(hdl64e.scan(&urban, &urban_pose, 1, 0))))
+    });
+    group.bench_function(
+        format!("urban/hdl64e/{}-threads", rayon::current_num_threads()),
+        |b| b.iter(|| black_box(hdl64e.scan(&urban, &urban_pose, 1, 0))),
     );
 
     let config = SynpebConfig::default();
