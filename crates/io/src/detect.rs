@@ -250,10 +250,16 @@ fn detect_dir(path: &Path) -> Result<Format> {
         || has("sensor_data")
         || has("velodyne_hits.bin")
         || dir_has_prefix(path, "groundtruth_")
+        || !nclt::session_dirs(path).is_empty()
     {
         return Ok(Format::NcltSession);
     }
-    if has("velodyne") || has("poses.txt") || has("times.txt") || has("calib.txt") {
+    if has("velodyne")
+        || has("poses.txt")
+        || has("times.txt")
+        || has("calib.txt")
+        || kitti::is_dataset_root(path)
+    {
         return Ok(Format::KittiSequence);
     }
     Err(Error::UnknownFormat {

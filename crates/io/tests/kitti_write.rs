@@ -208,4 +208,24 @@ fn a_written_sequence_is_discovered_and_summarized() {
     assert_eq!(summary.points, Some(33));
     assert_eq!(summary.poses, Some(3));
     assert_eq!(summary.extra["times"], 3);
+    // The benchmark root sums its sequences.
+    let second = KittiLayout::new(dir.path().join("dataset"), "08");
+    second.create_dirs().unwrap();
+    kitti::write_velodyne(
+        &second.scan_path(0),
+        &PointCloud::from_points(vec![Point3::origin()]),
+    )
+    .unwrap();
+    kitti::write_poses(&second.poses_path(), &poses[..1]).unwrap();
+    let root = dir.path().join("dataset");
+    assert_eq!(
+        raypath_io::Format::detect(&root).unwrap(),
+        raypath_io::Format::KittiSequence
+    );
+    let summary = raypath_io::summarize(&root).unwrap();
+    assert_eq!(summary.scans, Some(4));
+    assert_eq!(summary.points, Some(34));
+    assert_eq!(summary.poses, Some(4));
+    assert_eq!(summary.extra["times"], 3);
+    assert_eq!(summary.extra["sequences"], serde_json::json!(["07", "08"]));
 }

@@ -177,6 +177,18 @@ fn a_written_session_is_discovered_and_summarized() {
     assert_eq!(summary.points, Some(10));
     assert_eq!(summary.poses, Some(2));
     assert_eq!(summary.odometry, Some(2));
+    // A folder of sessions sums them.
+    let later = NcltLayout::new(dir.path(), "2012-02-04");
+    later.create_dirs().unwrap();
+    nclt::write_pose_csv(&later.ground_truth_path(), &rows[..1]).unwrap();
+    let summary = raypath_io::summarize(dir.path()).unwrap();
+    assert_eq!(summary.format, "nclt");
+    assert_eq!(summary.scans, Some(2));
+    assert_eq!(summary.poses, Some(3));
+    assert_eq!(
+        summary.extra["sessions"],
+        serde_json::json!(["2012-01-08", "2012-02-04"])
+    );
 }
 
 #[test]

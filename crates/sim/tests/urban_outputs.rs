@@ -70,6 +70,9 @@ fn kitti_style_sequence_reads_back_with_consistent_frames_and_poles() {
     assert_eq!(summary.extra["times"], 4);
     assert_eq!(set.stats["scans"]["points"], summary.points.unwrap());
     assert!(set.files.iter().any(|f| f.ends_with("poses/00.txt")));
+    // raypath info on the set's directory (the benchmark root).
+    let root = raypath_io::summarize(dir.path()).unwrap();
+    assert_eq!((root.scans, root.poses), (Some(4), Some(4)));
     let sequence = KittiSequence::open(&seq_dir).unwrap();
     let calib = sequence.calib().unwrap().unwrap();
     let camera_poses = sequence.poses().unwrap();
@@ -217,6 +220,10 @@ fn nclt_style_sessions_read_back_in_rep103() {
     let set = generate_nclt(&config, 5, dir.path(), no_progress()).unwrap();
     assert_eq!(set.stats["sessions"].as_array().unwrap().len(), 2);
     let root_poles = std::fs::read(dir.path().join("poles.csv")).unwrap();
+    // raypath info on the set's directory (the folder of sessions).
+    let root = raypath_io::summarize(dir.path()).unwrap();
+    assert_eq!(root.format, "nclt");
+    assert_eq!((root.scans, root.poses, root.odometry), (Some(6), Some(6), Some(42)));
     for (k, date) in config.sessions.iter().enumerate() {
         let session_dir = dir.path().join(date);
         let summary = raypath_io::summarize(&session_dir).unwrap();

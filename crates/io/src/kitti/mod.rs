@@ -39,7 +39,7 @@ use std::path::Path;
 use raypath_geometry::Aabb3;
 
 use crate::summary::{BoundingBox, Summary, TimeSpan};
-use crate::{Format, Result};
+use crate::{Error, Format, Location, Result};
 
 pub use calib::{KittiCalib, parse_calib, read_calib};
 pub use poses::{
@@ -77,9 +77,66 @@ pub fn summarize(path: &Path, format: Format) -> Result<Summary> {
             let keys: Vec<&str> = calib.keys().collect();
             summary = summary.with_extra("keys", keys);
         }
+        _ if is_dataset_root(path) => return summarize_dataset(path, summary),
         _ => return summarize_sequence(path, summary),
     }
     Ok(summary)
+}
+
+/// A benchmark root (`dataset/` holding `sequences/NN/` and `poses/NN.txt`) rather than a
+/// sequence directory.
+pub(crate) fn is_dataset_root(path: &Path) -> bool {
+    path.join("sequences").is_dir()
+        && !["velodyne", "poses.txt", "times.txt", "calib.txt"]
+            .iter()
+            .any(|name| path.join(name).exists())
+}
+
+/// The sums over the sequences of a benchmark root, with their names in `sequences`.
+fn summarize_dataset(root: &Path, mut summary: Summary) -> Result<Summary> {
+    let dir = root.join("sequences");
+    let entries = std::fs::read_dir(&dir).map_err(|e| Error::io(&dir, Location::File, e))?;
+    let mut dirs = Vec::new();
+    for entry in entries {
+        let path = entry
+            .map_err(|e| Error::io(&dir, Location::File, e))?
+            .path();
+        if path.is_dir() {
+            dirs.push(path);
+        }
+    }
+    dirs.sort();
+    if dirs.is_empty() {
+        return Err(Error::UnknownFormat {
+            path: root.to_path_buf(),
+            reason: "sequences/ holds no sequence directories".into(),
+        });
+    }
+    let add = |total: &mut Option<u64>, part: Option<u64>| {
+        if let Some(part) = part {
+            *total = Some(total.unwrap_or(0) + part);
+        }
+    };
+    let (mut names, mut times) = (Vec::new(), None);
+    for dir in &dirs {
+        let part = summarize_sequence(dir, Summary::new(summary.format.clone()))?;
+        add(&mut summary.scans, part.scans);
+        add(&mut summary.points, part.points);
+        add(&mut summary.poses, part.poses);
+        add(
+            &mut times,
+            part.extra.get("times").and_then(serde_json::Value::as_u64),
+        );
+        names.push(
+            dir.file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+        );
+    }
+    if let Some(times) = times {
+        summary = summary.with_extra("times", times);
+    }
+    Ok(summary.with_extra("sequences", names))
 }
 
 fn summarize_sequence(path: &Path, mut summary: Summary) -> Result<Summary> {

@@ -127,9 +127,77 @@ pub fn summarize(path: &Path, format: Format) -> Result<Summary> {
             summary.time_span =
                 TimeSpan::from_times(table.records.iter().map(|r| utime_to_secs(r.utime)));
         }
+        _ if !is_session_dir(path) && !session_dirs(path).is_empty() => {
+            return summarize_sessions(path, summary);
+        }
         _ => return summarize_session(path, summary),
     }
     Ok(summary)
+}
+
+/// True when `path` holds the folders of a session (`velodyne_data/`, `ground_truth/`,
+/// `sensor_data/`).
+fn is_session_dir(path: &Path) -> bool {
+    ["velodyne_data", "ground_truth", "sensor_data"]
+        .iter()
+        .any(|name| path.join(name).is_dir())
+}
+
+/// The session folders (`YYYY-MM-DD/` holding session folders) directly inside `path`, sorted.
+pub(crate) fn session_dirs(path: &Path) -> Vec<std::path::PathBuf> {
+    let Ok(entries) = std::fs::read_dir(path) else {
+        return Vec::new();
+    };
+    let mut dirs: Vec<_> = entries
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| {
+            let name = p
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            let is_date = name.len() == 10
+                && name.char_indices().all(|(i, c)| {
+                    if i == 4 || i == 7 {
+                        c == '-'
+                    } else {
+                        c.is_ascii_digit()
+                    }
+                });
+            is_date && is_session_dir(p)
+        })
+        .collect();
+    dirs.sort();
+    dirs
+}
+
+/// The sums over the sessions in a folder of sessions, with their dates in `sessions`.
+fn summarize_sessions(path: &Path, mut summary: Summary) -> Result<Summary> {
+    let add = |total: &mut Option<u64>, part: Option<u64>| {
+        if let Some(part) = part {
+            *total = Some(total.unwrap_or(0) + part);
+        }
+    };
+    let mut dates = Vec::new();
+    let mut span: Option<TimeSpan> = None;
+    for dir in session_dirs(path) {
+        let part = summarize_session(&dir, Summary::new(summary.format.clone()))?;
+        add(&mut summary.scans, part.scans);
+        add(&mut summary.points, part.points);
+        add(&mut summary.poses, part.poses);
+        add(&mut summary.odometry, part.odometry);
+        if let Some(t) = part.time_span {
+            TimeSpan::extend(&mut span, t.start);
+            TimeSpan::extend(&mut span, t.end);
+        }
+        dates.push(
+            dir.file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+        );
+    }
+    summary.time_span = span;
+    Ok(summary.with_extra("sessions", dates))
 }
 
 fn summarize_session(path: &Path, mut summary: Summary) -> Result<Summary> {
