@@ -10,7 +10,12 @@
 //! * `synpeb/500x500`: the organized 500 × 500 scanner of the SynPEB-style generator in one of
 //!   its rooms (≈ 6 × 7 × 3 m with polyhedral objects).
 //!
-//! Each is run on one thread (a one-thread rayon pool) and on all cores (the global pool).
+//! * `urban/cast-bvh` and `urban/cast-parry-trimesh`: ray casting alone (no noise, intensity or
+//!   output) of the HDL-64E's beams in the urban scene, with the simulator's own BVH
+//!   (`Scene3::cast`) and with parry3d's `TriMesh` over the same triangles — the comparison
+//!   that decided for the own BVH.
+//!
+//! Each scan is run on one thread (a one-thread rayon pool) and on all cores (the global pool).
 //! Run with `cargo bench -p raypath-sim --bench rays`.
 
 use std::hint::black_box;
@@ -113,6 +118,20 @@ fn street_scene() -> Scene3 {
     b.build().expect("the street has triangles")
 }
 
+/// The scene's triangles as one parry3d `TriMesh` (for the comparison).
+fn parry_mesh(scene: &Scene3) -> parry3d_f64::shape::TriMesh {
+    let mut vertices = Vec::with_capacity(3 * scene.num_triangles());
+    let mut indices = Vec::with_capacity(scene.num_triangles());
+    for i in 0..scene.num_triangles() {
+        if let Some(corners) = scene.triangle(i) {
+            let base = vertices.len() as u32;
+            vertices.extend_from_slice(&corners);
+            indices.push([base, base + 1, base + 2]);
+        }
+    }
+    parry3d_f64::shape::TriMesh::new(vertices, indices).expect("a triangle mesh")
+}
+
 fn bench_rays(c: &mut Criterion) {
     let mut group = c.benchmark_group("rays");
     group.sample_size(10);
@@ -156,6 +175,41 @@ fn bench_rays(c: &mut Criterion) {
         format!("urban/hdl64e/{}-threads", rayon::current_num_threads()),
         |b| b.iter(|| black_box(hdl64e.scan(&urban, &urban_pose, 1, 0))),
     );
+
+    // Ray casting alone, the scene's BVH against parry3d's TriMesh on the same triangles:
+    // the HDL-64E's nominal beams from the urban pose, one thread.
+    let origin = Point3::from(urban_pose.translation());
+    let beams: Vec<nalgebra::Unit<Vector3<f64>>> = hdl64e
+        .elevations_rad
+        .iter()
+        .flat_map(|&el| hdl64e.azimuths_rad.iter().map(move |&az| (el, az)))
+        .map(|(el, az)| urban_pose.rotation() * raypath_geometry::spherical_direction(el, az))
+        .collect();
+    group.bench_function("urban/cast-bvh/1-thread", |b| {
+        b.iter(|| {
+            beams
+                .iter()
+                .filter_map(|d| urban.cast(&origin, d, hdl64e.max_range_m))
+                .count()
+        })
+    });
+    let mesh = parry_mesh(&urban);
+    group.bench_function("urban/cast-parry-trimesh/1-thread", |b| {
+        b.iter(|| {
+            beams
+                .iter()
+                .filter_map(|d| {
+                    let ray = parry3d_f64::query::Ray::new(origin, d.into_inner());
+                    parry3d_f64::query::RayCast::cast_local_ray_and_get_normal(
+                        &mesh,
+                        &ray,
+                        hdl64e.max_range_m,
+                        false,
+                    )
+                })
+                .count()
+        })
+    });
 
     let config = SynpebConfig::default();
     let room = synpeb::build_room(&config, 7, 0).expect("a room");

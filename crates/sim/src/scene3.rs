@@ -1,17 +1,19 @@
 //! 3-D scenes: a triangle soup in one BVH, every triangle tagged with the surface it belongs
-//! to, for exact first-hit ray casting with parry3d (f64).
+//! to, for exact first-hit ray casting (f64; an SAH bounding volume hierarchy of our own,
+//! cross-checked against parry3d's `TriMesh`).
 //!
 //! Solids: polygons, boxes, cylinders (plain or with separate caps), prisms, wedges, stairs and
 //! spheres ([`SceneBuilder3::add_prism`] and friends).
 
 use nalgebra::{Point3, Unit, Vector3};
-use parry3d_f64::query::{Ray, RayCast};
-use parry3d_f64::shape::{FeatureId, TriMesh};
 use raypath_geometry::{Aabb3, Pose3};
 
 use crate::error::{Result, SimError};
 
+mod bvh;
 mod primitives;
+
+use bvh::Bvh;
 
 pub(crate) use primitives::is_convex_ccw;
 
@@ -140,20 +142,31 @@ impl SceneBuilder3 {
         self.add_capped_cylinder(base_center, radius_m, height_m, segments, [surface; 3]);
     }
 
-    /// Builds the BVH. Fails for a scene without triangles.
+    /// Builds the BVH. Fails for a scene without triangles or with non-finite coordinates.
     pub fn build(self) -> Result<Scene3> {
         if self.triangles.is_empty() {
             return Err(SimError::InvalidScene {
                 reason: "the scene has no triangles".into(),
             });
         }
+        if self
+            .vertices
+            .iter()
+            .any(|v| !v.iter().all(|c| c.is_finite()))
+        {
+            return Err(SimError::InvalidScene {
+                reason: "a vertex has non-finite coordinates".into(),
+            });
+        }
         let bounds = Aabb3::from_points(self.vertices.iter());
-        let mesh =
-            TriMesh::new(self.vertices, self.triangles).map_err(|e| SimError::InvalidScene {
-                reason: format!("triangle mesh: {e:?}"),
-            })?;
+        let corners: Vec<[Point3<f64>; 3]> = self
+            .triangles
+            .iter()
+            .map(|t| t.map(|i| self.vertices[i as usize]))
+            .collect();
         Ok(Scene3 {
-            mesh,
+            bvh: Bvh::build(&corners),
+            corners,
             triangle_surfaces: self.triangle_surfaces,
             surfaces: self.surfaces,
             bounds,
@@ -162,41 +175,45 @@ impl SceneBuilder3 {
 }
 
 /// A built scene: first-hit ray casting against all triangles.
-#[derive(Clone)]
+#[derive(Clone, Debug)]
 pub struct Scene3 {
-    mesh: TriMesh,
+    bvh: Bvh,
+    corners: Vec<[Point3<f64>; 3]>,
     triangle_surfaces: Vec<SurfaceId>,
     surfaces: Vec<Surface>,
     bounds: Aabb3,
 }
 
 impl Scene3 {
-    /// The first hit of the ray `origin + t · direction`, `0 < t ≤ max_range_m`, if any.
+    /// The first hit of the ray `origin + t · direction` (`direction` a unit vector),
+    /// `0 ≤ t < max_range_m`, if any; triangles are two-sided.
     pub fn cast(
         &self,
         origin: &Point3<f64>,
         direction: &Unit<Vector3<f64>>,
         max_range_m: f64,
     ) -> Option<Hit3> {
-        let ray = Ray::new(*origin, direction.into_inner());
-        let hit = self
-            .mesh
-            .cast_local_ray_and_get_normal(&ray, max_range_m, false)?;
-        let n_triangles = self.triangle_surfaces.len() as u32;
-        // parry reports back-face hits of triangle i as Face(i + n_triangles).
-        let triangle = match hit.feature {
-            FeatureId::Face(id) => id % n_triangles,
-            _ => return None,
+        let hit = self.bvh.cast(origin, direction, max_range_m)?;
+        let normal = if hit.normal.dot(direction) > 0.0 {
+            -hit.normal
+        } else {
+            hit.normal
         };
-        let mut normal = hit.normal;
-        if normal.dot(direction) > 0.0 {
-            normal = -normal;
-        }
         Some(Hit3 {
-            range_m: hit.time_of_impact,
-            normal: Unit::try_new(normal, 0.0)?,
-            surface: *self.triangle_surfaces.get(triangle as usize)?,
+            range_m: hit.t,
+            normal: Unit::new_unchecked(normal),
+            surface: *self.triangle_surfaces.get(hit.triangle as usize)?,
         })
+    }
+
+    /// The corners of triangle `index` (in the order they were added), if it exists.
+    pub fn triangle(&self, index: usize) -> Option<[Point3<f64>; 3]> {
+        self.corners.get(index).copied()
+    }
+
+    /// The surface of triangle `index`, if it exists.
+    pub fn triangle_surface(&self, index: usize) -> Option<SurfaceId> {
+        self.triangle_surfaces.get(index).copied()
     }
 
     /// The surface with this id.

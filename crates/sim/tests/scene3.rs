@@ -232,3 +232,87 @@ fn sphere_hits_within_the_facet_tolerance() {
         assert_eq!(label, 2);
     }
 }
+
+/// The scene's own BVH against parry3d's `TriMesh` on 20 000 random rays through a cluttered
+/// scene with long triangles (split into pieces inside the BVH): same hits, same ranges.
+#[test]
+fn bvh_agrees_with_parry_trimesh() {
+    use parry3d_f64::query::{Ray, RayCast};
+    use parry3d_f64::shape::TriMesh;
+    use rand::{Rng, SeedableRng};
+
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    let mut b = SceneBuilder3::new();
+    let s = surfaces(&mut b, 10..60);
+    b.add_polygon(
+        &[
+            Point3::new(-300.0, -40.0, 0.0),
+            Point3::new(300.0, -40.0, 0.0),
+            Point3::new(300.0, 40.0, 0.0),
+            Point3::new(-300.0, 40.0, 0.0),
+        ],
+        s[0],
+    );
+    for i in 0..300 {
+        let pose = Pose3::from_xyz_rpy(
+            rng.random_range(-100.0..100.0),
+            rng.random_range(-30.0..30.0),
+            rng.random_range(0.0..5.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-3.0..3.0),
+        );
+        let half = Vector3::new(
+            rng.random_range(0.1..8.0),
+            rng.random_range(0.1..3.0),
+            rng.random_range(0.1..2.0),
+        );
+        let faces = [0; 6].map(|_| s[rng.random_range(1..50)]);
+        if i % 3 == 0 {
+            let base = Point3::new(pose.translation().x, pose.translation().y, 0.0);
+            b.add_cylinder(base, half.y / 4.0, half.z * 3.0, 24, faces[0]);
+        } else {
+            b.add_box(&pose, half, faces);
+        }
+    }
+    let scene = b.build().unwrap();
+    let (vertices, indices): (Vec<Point3<f64>>, Vec<[u32; 3]>) = (0..scene.num_triangles())
+        .map(|i| {
+            let corners = scene.triangle(i).unwrap();
+            let base = 3 * i as u32;
+            (corners, [base, base + 1, base + 2])
+        })
+        .fold((Vec::new(), Vec::new()), |(mut v, mut t), (c, idx)| {
+            v.extend_from_slice(&c);
+            t.push(idx);
+            (v, t)
+        });
+    let mesh = TriMesh::new(vertices, indices).unwrap();
+    let (mut hits, mut mismatches) = (0, 0);
+    for _ in 0..20_000 {
+        let origin = Point3::new(
+            rng.random_range(-120.0..120.0),
+            rng.random_range(-35.0..35.0),
+            rng.random_range(0.5..6.0),
+        );
+        let dir = Unit::new_normalize(Vector3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-0.5..0.3),
+        ));
+        let ours = scene.cast(&origin, &dir, 150.0);
+        let theirs = mesh.cast_local_ray(&Ray::new(origin, dir.into_inner()), 150.0, false);
+        match (ours, theirs) {
+            (Some(h), Some(t)) => {
+                hits += 1;
+                if (h.range_m - t).abs() > 1e-7 {
+                    mismatches += 1;
+                }
+            }
+            (None, None) => {}
+            _ => mismatches += 1,
+        }
+    }
+    assert!(hits > 10_000, "{hits}");
+    assert!(mismatches <= 2, "{mismatches} of 20 000 rays disagree");
+}

@@ -6,11 +6,15 @@
 //!
 //! A room ([`build_room`]) with floor, ceiling and four walls and random objects: cuboids,
 //! wedges (ramps), prisms with 3, 5 or 6 sides, stairs, tables (top and four legs), shelves
-//! (sides, back panel, boards), cuboids and prisms tumbled into a random orientation resting on
-//! a vertex, cylinders and spheres, standing free or against a wall, and small objects on
-//! tables and cuboids. Objects do not overlap (oriented footprints with a 5 cm gap). By
-//! default the whole set is sampled in **one** room — the thesis speaks of "the virtual room
-//! from which the SynPEB lidar scans are sampled" — from different sensor poses.
+//! (sides, back panel, boards), wall-mounted cabinets, cuboids and prisms tumbled into a
+//! random orientation resting on a vertex, cylinders and spheres, standing free or against a
+//! wall, and small objects on tables and cuboids. The kinds are mixed in fixed proportions
+//! (so rooms of one seed and another differ in layout, not in make-up), and objects do not
+//! overlap (oriented footprints with a 5 cm gap). A few sensor stations per room are kept
+//! clear of objects (0.5 m around); each scan is taken from a random station, moved by up to
+//! 0.2 m, 0.5–1.5 m above the floor, looking at an object at least 2.5 m away. By default the
+//! whole set is sampled in **one** room — the thesis speaks of "the virtual room from which
+//! the SynPEB lidar scans are sampled" — from different sensor poses.
 //!
 //! ## Labels
 //!
