@@ -4,10 +4,14 @@
 //! cargo xtask eval <name>|all [--quick]   run evaluations, print tables, write docs/results/
 //! cargo xtask eval list                   list the evaluations
 //! cargo xtask datasets                    what RAYPATH_DATA holds and what is missing
+//! cargo xtask datasets generate [--quick] [--only NAME] [--seed S]
+//!                                         write the simulated sets under datasets/generated/
 //! ```
 
 mod datasets;
 mod eval;
+mod generate;
+mod render;
 mod table;
 
 use anyhow::Result;
@@ -31,11 +35,30 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
-    /// List the data sets found under RAYPATH_DATA and the ones missing, with where to get them.
+    /// List the data sets found under RAYPATH_DATA and the ones missing, with where to get them;
+    /// `datasets generate` writes the simulated sets under datasets/generated/.
     Datasets {
         /// Print machine-readable JSON instead of a table.
         #[arg(long)]
         json: bool,
+        #[command(subcommand)]
+        action: Option<DatasetsAction>,
+    },
+}
+
+#[derive(Subcommand)]
+enum DatasetsAction {
+    /// Generate the simulated data sets (deterministic: same seed, identical files).
+    Generate {
+        /// The smaller configuration (under 5 minutes on 2 cores) that `eval all --quick` uses.
+        #[arg(long)]
+        quick: bool,
+        /// Generate only this set.
+        #[arg(long, value_name = "NAME")]
+        only: Option<String>,
+        /// Seed (default: the embedded default data's seed).
+        #[arg(long)]
+        seed: Option<u64>,
     },
 }
 
@@ -43,6 +66,11 @@ fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Eval { name, quick } => eval::run(&name, quick),
-        Command::Datasets { json } => datasets::run(json),
+        Command::Datasets { json, action } => match action {
+            None => datasets::run(json),
+            Some(DatasetsAction::Generate { quick, only, seed }) => {
+                generate::run(quick, only.as_deref(), seed)
+            }
+        },
     }
 }

@@ -2,6 +2,8 @@
 //!
 //! ```text
 //! raypath info <path> [--json] [--format <name>]
+//! raypath simulate <kind> --out DIR [--seed S] [--quick] [--scans N] [--json]
+//! raypath simulate semi-kitti --poses poses.txt --times times.txt --poles poles.csv --out DIR
 //! ```
 //!
 //! Every subcommand prints a human-readable report, or with `--json` one JSON document on
@@ -31,12 +33,16 @@ enum Command {
     /// Detect a file's format and summarize it: scans, beams, points, poses, odometry,
     /// organized size, labels, bounding box, time span. A KITTI or NCLT directory is one input.
     Info(commands::info::Args),
+    /// Generate simulated data in real formats (CARMEN, PCD, KITTI, NCLT): polygons, indoor
+    /// worlds, the 1-D corridor, SynPEB-style rooms, urban drives, semi-synthetic KITTI.
+    Simulate(commands::simulate::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Info(args) => commands::info::run(args),
+        Command::Simulate(args) => commands::simulate::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -13,6 +13,7 @@
 
 pub mod corridor;
 mod dataset;
+pub mod datasets;
 mod error;
 pub mod indoor;
 pub mod lidar3;
@@ -21,8 +22,8 @@ pub mod polygons;
 pub mod rng;
 pub mod scene2;
 pub mod scene3;
-pub mod synpeb;
 pub mod semi_kitti;
+pub mod synpeb;
 pub mod urban;
 
 pub use dataset::{GeneratedSet, Progress, no_progress};

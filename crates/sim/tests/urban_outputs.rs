@@ -223,7 +223,10 @@ fn nclt_style_sessions_read_back_in_rep103() {
     // raypath info on the set's directory (the folder of sessions).
     let root = raypath_io::summarize(dir.path()).unwrap();
     assert_eq!(root.format, "nclt");
-    assert_eq!((root.scans, root.poses, root.odometry), (Some(6), Some(6), Some(42)));
+    assert_eq!(
+        (root.scans, root.poses, root.odometry),
+        (Some(6), Some(6), Some(42))
+    );
     for (k, date) in config.sessions.iter().enumerate() {
         let session_dir = dir.path().join(date);
         let summary = raypath_io::summarize(&session_dir).unwrap();

@@ -24,6 +24,7 @@ use raypath_io::carmen::{CarmenReader, FanConvention, Record};
 use serde_json::json;
 
 use super::{EvalContext, EvalReport};
+use crate::render::TopDown;
 use crate::table::{Table, fmt_num};
 
 /// Grid cell size of the sharpness score in metres.
@@ -169,52 +170,18 @@ fn score(points: &[(f64, f64)]) -> Score {
     }
 }
 
-/// The `q` and `1 − q` quantiles of `values` (sorted in place), widened by 2 %.
-fn robust_bounds(values: &mut [f64], q: f64) -> (f64, f64) {
-    values.sort_unstable_by(f64::total_cmp);
-    let at = |f: f64| values[((values.len() - 1) as f64 * f) as usize];
-    let (lo, hi) = (at(q), at(1.0 - q));
-    let pad = 0.02 * (hi - lo);
-    (lo - pad, hi + pad)
-}
-
 /// Renders hit counts as a grayscale picture (white background, darker = more hits), north
 /// up, at a cell size that keeps the larger side near `PICTURE_PX` pixels (5 cm at least).
 /// The frame covers the 0.2–99.8 % quantiles of x and y, so a few hits through windows do
 /// not shrink the building.
 fn picture(points: &[(f64, f64)], path: &Path) -> Result<()> {
-    if points.is_empty() {
+    let Some(mut top) = TopDown::fit(points, 0.002, CELL_M, PICTURE_PX) else {
         return Ok(());
-    }
-    let (min_x, max_x) = robust_bounds(&mut points.iter().map(|p| p.0).collect::<Vec<_>>(), 0.002);
-    let (min_y, max_y) = robust_bounds(&mut points.iter().map(|p| p.1).collect::<Vec<_>>(), 0.002);
-    let cell = ((max_x - min_x).max(max_y - min_y) / PICTURE_PX).max(CELL_M);
-    let width = ((max_x - min_x) / cell).floor() as u32 + 1;
-    let height = ((max_y - min_y) / cell).floor() as u32 + 1;
-    let mut counts = vec![0u32; width as usize * height as usize];
+    };
     for &(x, y) in points {
-        if !(min_x..=max_x).contains(&x) || !(min_y..=max_y).contains(&y) {
-            continue;
-        }
-        let col = ((x - min_x) / cell) as usize;
-        let row = ((max_y - y) / cell) as usize;
-        if let Some(c) = counts.get_mut(row * width as usize + col) {
-            *c += 1;
-        }
+        top.hit(x, y);
     }
-    let image = image::GrayImage::from_fn(width, height, |col, row| {
-        let c = counts[(row * width + col) as usize];
-        // 1 hit: light grey, 8+ hits: black.
-        let shade = if c == 0 {
-            255
-        } else {
-            (200.0 * (1.0 - (f64::from(c).log2() / 3.0).min(1.0))) as u8
-        };
-        image::Luma([shade])
-    });
-    image
-        .save(path)
-        .with_context(|| format!("writing {}", path.display()))
+    top.save(path)
 }
 
 /// Offsets of the first and the last beam, in half nominal steps, tried by the sweep.

@@ -7,6 +7,7 @@
 mod carmen_angles;
 mod geometry;
 mod io;
+mod sim;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -79,6 +80,11 @@ const EVALUATIONS: &[(&str, &str, EvalFn)] = &[
         "geometry",
         "exact ray traversal throughput in 2-D and 3-D (cells per second)",
         geometry::run,
+    ),
+    (
+        "sim",
+        "simulated data sets: contents, statistics beside real samples, pictures",
+        sim::run,
     ),
     (
         "carmen-angles",

@@ -1,6 +1,7 @@
 //! One module per subcommand, plus the shared failure type.
 
 pub mod info;
+pub mod simulate;
 
 use std::process::ExitCode;
 

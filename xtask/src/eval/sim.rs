@@ -1,0 +1,624 @@
+//! `cargo xtask eval sim`: what each simulated data set contains, its statistics beside the
+//! real samples and the thesis, checks that raypath-io reads every file, and pictures.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use raypath_geometry::Range;
+use raypath_io::carmen::{CarmenReader, Record};
+use raypath_io::kitti::{self, KittiSequence};
+use raypath_io::pcd::{self, ReadOptions};
+use raypath_sim::datasets::SETS;
+use serde_json::Value;
+
+use super::{EvalContext, EvalReport};
+use crate::generate;
+use crate::render::{TopDown, colormap, label_color};
+use crate::table::{Table, fmt_num};
+
+/// A generated set on disk with its bookkeeping.
+struct SetOnDisk {
+    name: &'static str,
+    about: &'static str,
+    dir: PathBuf,
+    info: Value,
+}
+
+impl SetOnDisk {
+    fn stat(&self, path: &str) -> Option<&Value> {
+        path.split('.')
+            .try_fold(&self.info["stats"], |v, key| v.get(key))
+    }
+
+    fn num(&self, path: &str) -> f64 {
+        self.stat(path).and_then(Value::as_f64).unwrap_or(f64::NAN)
+    }
+}
+
+/// Runs the evaluation.
+pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
+    let mut sets = Vec::new();
+    let mut skipped = Vec::new();
+    for spec in SETS {
+        if let Some(required) = spec.requires
+            && raypath_io::data::find(required).is_none()
+        {
+            skipped.push(format!(
+                "`{}` (needs `{required}` in RAYPATH_DATA)",
+                spec.name
+            ));
+            continue;
+        }
+        let dir = generate::ensure(spec.name, ctx.quick)?;
+        let text = std::fs::read_to_string(dir.join("set.json"))
+            .with_context(|| format!("reading {}/set.json", dir.display()))?;
+        sets.push(SetOnDisk {
+            name: spec.name,
+            about: spec.about,
+            dir,
+            info: serde_json::from_str(&text)?,
+        });
+    }
+
+    let mut md = String::from(
+        "Simulated data sets written by `raypath-sim` (`cargo xtask datasets generate`) in the \
+         real formats, read back here through `raypath-io` exactly like real data. **Every row \
+         of this page is simulated**, except the columns marked *real*, which are measured on \
+         the real samples in `RAYPATH_DATA` or quoted from the thesis.\n\n",
+    );
+
+    // What each set holds and whether raypath-io reads all of it.
+    let bar = ctx.progress(sets.len() as u64, "reading sets");
+    let mut table = Table::new([
+        "set",
+        "stands in for",
+        "files",
+        "MB",
+        "mode",
+        "read by raypath-io",
+    ]);
+    let mut readability = Vec::new();
+    for set in &sets {
+        let (readable, total, failures) = check_readable(set)?;
+        readability.push(serde_json::json!({"set": set.name, "readable": readable, "data_files": total, "failures": failures}));
+        table.row([
+            format!("`{}`", set.name),
+            set.about.to_owned(),
+            set.info["files"].as_array().map_or(0, Vec::len).to_string(),
+            fmt_num(set.info["bytes"].as_f64().unwrap_or(0.0) / 1e6, 1),
+            if set.info["quick"].as_bool() == Some(true) {
+                "quick"
+            } else {
+                "full"
+            }
+            .to_owned(),
+            format!("{readable}/{total} files"),
+        ]);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    md.push_str("## The sets\n\n");
+    md.push_str(&table.to_markdown());
+    md.push_str(
+        "\nEvery data file is summarized by raypath-io as `raypath info` does; data files are everything but the ground-truth JSON \
+         files (world descriptions, polygon vertices, corridor runs) and SemanticKITTI-style \
+         `.label` files, which are not sensor formats raypath reads. KITTI- and NCLT-style \
+         sets are also read as whole directories (`raypath info <set>`). Same seed, same bytes: \
+         every set carries `SHA256SUMS`; `cargo xtask datasets generate --quick` twice gives \
+         identical sums (tested in `crates/sim/tests`).\n",
+    );
+    if !skipped.is_empty() {
+        md.push_str(&format!("\nSkipped: {}.\n", skipped.join(", ")));
+    }
+
+    md.push_str("\n## Statistics beside the real data and the thesis\n\n");
+    md.push_str(&comparison_table(&sets, ctx)?.to_markdown());
+
+    md.push_str("\n## Pictures\n\n");
+    let figures = ctx.figure_dir("sim")?;
+    for set in &sets {
+        for (caption, file) in pictures(set, &figures)? {
+            md.push_str(&format!("**{caption}**\n\n![{caption}](sim/{file})\n\n"));
+        }
+    }
+
+    let json = serde_json::json!({
+        "sets": sets.iter().map(|s| serde_json::json!({
+            "name": s.name, "dir": s.dir.display().to_string(), "quick": s.info["quick"],
+            "bytes": s.info["bytes"], "stats": s.info["stats"],
+        })).collect::<Vec<_>>(),
+        "readability": readability,
+        "skipped": skipped,
+    });
+    Ok(EvalReport {
+        name: "sim",
+        title: "Simulated data sets: contents, statistics and pictures".into(),
+        markdown: md,
+        json,
+    })
+}
+
+/// Reads every data file of a set (and the directory, for KITTI/NCLT layouts) with
+/// raypath-io: `(readable, data files, failures)`.
+fn check_readable(set: &SetOnDisk) -> Result<(usize, usize, Vec<String>)> {
+    let mut failures = Vec::new();
+    let files = set.info["files"].as_array().cloned().unwrap_or_default();
+    let mut data_files = 0;
+    let mut readable = 0;
+    for entry in &files {
+        let Some(relative) = entry["path"].as_str() else {
+            continue;
+        };
+        // Ground-truth JSON and SemanticKITTI label files are not sensor formats.
+        if relative.ends_with(".json") || relative.ends_with(".label") {
+            continue;
+        }
+        data_files += 1;
+        match raypath_io::summarize(&set.dir.join(relative)) {
+            Ok(_) => readable += 1,
+            Err(e) => failures.push(e.to_string()),
+        }
+    }
+    if matches!(set.name, "urban-kitti" | "urban-nclt" | "semi-kitti")
+        && let Err(e) = raypath_io::summarize(&set.dir)
+    {
+        failures.push(e.to_string());
+    }
+    Ok((readable, data_files, failures))
+}
+
+/// Real-sample figures: the SynPEB sample and the corrected CARMEN logs.
+fn comparison_table(sets: &[SetOnDisk], ctx: &EvalContext) -> Result<Table> {
+    let mut table = Table::new([
+        "set",
+        "quantity",
+        "simulated",
+        "real / thesis",
+        "source of the right column",
+    ]);
+    let find = |name: &str| sets.iter().find(|s| s.name == name);
+    if let Some(s) = find("polygons") {
+        table.row([
+            "polygons",
+            "scans × rays",
+            &format!("{} × {}", s.num("scans"), s.num("rays_per_scan")),
+            "260 × 360",
+            "thesis ch. 10 protocol",
+        ]);
+        table.row([
+            "polygons",
+            "radial noise σ (m)",
+            &fmt_num(s.num("range_noise_std_m"), 4),
+            "0.03",
+            "thesis ch. 10 protocol",
+        ]);
+    }
+    if let Some(s) = find("indoor") {
+        let intel = real_log_stats(&ctx.data("carmen/corrected/intel-corrected.log.gz"));
+        for world in ["office", "lab", "hall"] {
+            if s.stat(world).is_none() {
+                continue;
+            }
+            table.row([
+                "indoor".to_owned(),
+                format!("{world}: scans, beams, mean range (m)"),
+                format!(
+                    "{} × {}, {}",
+                    s.num(&format!("{world}.scans")),
+                    s.num(&format!("{world}.beams_per_scan")),
+                    fmt_num(s.num(&format!("{world}.range_m.mean")), 2)
+                ),
+                intel.as_ref().map_or("—".into(), |(scans, beams, mean)| {
+                    format!("{scans} × {beams}, {}", fmt_num(*mean, 2))
+                }),
+                "real: intel-corrected.log.gz".to_owned(),
+            ]);
+            table.row([
+                "indoor".to_owned(),
+                format!("{world}: odometry drift per metre"),
+                fmt_num(s.num(&format!("{world}.odometry_drift.per_metre")), 4),
+                "—".into(),
+                "configurable (odometry alphas)".into(),
+            ]);
+        }
+    }
+    if let Some(s) = find("corridor") {
+        table.row([
+            "corridor",
+            "mean / variance of μ (reflection)",
+            &format!(
+                "{} / {}",
+                fmt_num(s.num("reflection.truth_mean"), 3),
+                fmt_num(s.num("reflection.truth_variance"), 4)
+            ),
+            "0.5 / 0.0833",
+            "U(0, 1), thesis §8.5.1",
+        ]);
+        table.row([
+            "corridor",
+            "mean / variance of λ (decay rate)",
+            &format!(
+                "{} / {}",
+                fmt_num(s.num("decay-rate.truth_mean"), 3),
+                fmt_num(s.num("decay-rate.truth_variance"), 3)
+            ),
+            "1 / 1",
+            "Gamma(1, 1), thesis §8.5.1",
+        ]);
+    }
+    if let Some(s) = find("synpeb") {
+        let real = real_synpeb(ctx);
+        table.row([
+            "synpeb",
+            "planes per scan (≥ 10 pixels)",
+            &fmt_num(s.num("full_scans.planes_per_scan_min_10_pixels.mean"), 1),
+            "42.6",
+            "thesis §11 (SynPEB)",
+        ]);
+        table.row([
+            "synpeb".to_owned(),
+            "planes in the 100 × 100 crop of the sample's window".into(),
+            fmt_num(s.num("crop_100x100_at_row_col_100.planes_per_scan.mean"), 1),
+            real.as_ref().map_or("—".into(), |r| r.planes.to_string()),
+            "real: synpeb-sample-100x100.pcd".into(),
+        ]);
+        table.row([
+            "synpeb".to_owned(),
+            "median range of the crop (m)".into(),
+            fmt_num(
+                s.num("crop_100x100_at_row_col_100.range_m.median_of_scan_medians"),
+                2,
+            ),
+            real.as_ref()
+                .map_or("—".into(), |r| fmt_num(r.median_range_m, 2)),
+            "real: synpeb-sample-100x100.pcd".into(),
+        ]);
+        table.row([
+            "synpeb".to_owned(),
+            "plane-pixel fraction (crop)".into(),
+            fmt_num(
+                s.num("crop_100x100_at_row_col_100.plane_pixel_fraction.mean"),
+                3,
+            ),
+            real.as_ref()
+                .map_or("—".into(), |r| fmt_num(r.plane_fraction, 3)),
+            "real: synpeb-sample-100x100.pcd".into(),
+        ]);
+    }
+    for (name, lidar, real) in [
+        ("urban-kitti", "HDL-64E", "≈ 120 000 (KITTI)"),
+        ("semi-kitti", "HDL-64E", "≈ 120 000 (KITTI)"),
+        ("urban-nclt", "HDL-32E", "≈ 50 000–70 000 (NCLT)"),
+    ] {
+        if let Some(s) = find(name) {
+            table.row([
+                name.to_owned(),
+                format!("{lidar} points per scan"),
+                fmt_num(s.num("scans.points_per_scan_mean"), 0),
+                real.to_owned(),
+                "published sensor figures".into(),
+            ]);
+            table.row([
+                name.to_owned(),
+                "simulated rays per second (2 cores)".into(),
+                format!("{:.2e}", s.num("rays_per_s")),
+                "≥ 2e6 (aim)".into(),
+                "issue 3".into(),
+            ]);
+        }
+    }
+    if let Some(s) = find("semi-kitti") {
+        table.row([
+            "semi-kitti",
+            "poles placed / in the real map",
+            &format!(
+                "{} / {}",
+                s.num("poles_placed.total"),
+                s.num("poles_in_input")
+            ),
+            &format!("{} (real)", s.num("poles_in_input")),
+            "real: kitti-poles/07/poles.csv",
+        ]);
+    }
+    Ok(table)
+}
+
+/// Scans, beams and mean hit range of a real corrected log.
+fn real_log_stats(path: &Path) -> Option<(usize, usize, f64)> {
+    let reader = CarmenReader::open(path).ok()?;
+    let (mut scans, mut beams, mut sum, mut hits) = (0, 0, 0.0, 0usize);
+    for record in reader.flatten() {
+        if let Record::Laser(laser) = record {
+            scans += 1;
+            beams = laser.scan.len();
+            for i in 0..laser.scan.len() {
+                if let Range::Hit(r) = laser.scan.range(i) {
+                    sum += r;
+                    hits += 1;
+                }
+            }
+        }
+    }
+    (scans > 0).then(|| (scans, beams, sum / hits.max(1) as f64))
+}
+
+struct RealSynpeb {
+    planes: usize,
+    median_range_m: f64,
+    plane_fraction: f64,
+}
+
+fn real_synpeb(ctx: &EvalContext) -> Option<RealSynpeb> {
+    let path = ctx.data("planes/synpeb-sample-100x100.pcd");
+    let read = pcd::read_pcd(&path, &ReadOptions::synpeb()).ok()?;
+    let labels = read.cloud.label.as_ref()?;
+    let mut planes: Vec<u32> = labels.iter().copied().filter(|&l| l >= 10).collect();
+    let plane_fraction = planes.len() as f64 / labels.len().max(1) as f64;
+    planes.sort_unstable();
+    planes.dedup();
+    let mut ranges: Vec<f64> = read
+        .cloud
+        .points
+        .iter()
+        .filter(|p| p.iter().all(|v| v.is_finite()))
+        .map(|p| f64::from(p.coords.norm()))
+        .collect();
+    Some(RealSynpeb {
+        planes: planes.len(),
+        median_range_m: super::median(&mut ranges),
+        plane_fraction,
+    })
+}
+
+/// Pictures of a set: `(caption, file name)`.
+fn pictures(set: &SetOnDisk, dir: &Path) -> Result<Vec<(String, String)>> {
+    let mut out = Vec::new();
+    match set.name {
+        "polygons" => {
+            let file = "polygons.png";
+            if polygons_picture(set, &dir.join(file))? {
+                out.push((
+                    "polygons: ground-truth polygon (blue) and the noisy scan (red), first scan"
+                        .into(),
+                    file.into(),
+                ));
+            }
+        }
+        "indoor" => {
+            let log = set.dir.join("office-corrected.log.gz");
+            let file = "indoor-office.png";
+            if log_picture(&log, &dir.join(file))? {
+                out.push(("indoor: the office world rendered from its corrected log (hits, grey) and the path (red)".into(), file.into()));
+            }
+        }
+        "synpeb" => {
+            let file = "synpeb-scan.png";
+            if synpeb_picture(set, &dir.join(file))? {
+                out.push(("synpeb: first test scan, range (left, near = dark) and plane labels (right; grey = curved, black = none)".into(), file.into()));
+            }
+        }
+        "urban-kitti" | "semi-kitti" => {
+            let top = format!("{}-top.png", set.name);
+            if kitti_top_down(set, &dir.join(&top))? {
+                out.push((format!("{}: every 5th scan in the world frame (grey), trajectory (red), ground-truth poles (blue)", set.name), top));
+            }
+            if set.name == "urban-kitti" {
+                let image = "urban-kitti-range.png";
+                if kitti_range_image(set, &dir.join(image))? {
+                    out.push(("urban-kitti: first HDL-64E scan as a range image (64 rows, each drawn 4 pixels high; near = dark)".into(), image.into()));
+                }
+            }
+        }
+        _ => {}
+    }
+    Ok(out)
+}
+
+fn polygons_picture(set: &SetOnDisk, path: &Path) -> Result<bool> {
+    let truth: Value =
+        serde_json::from_str(&std::fs::read_to_string(set.dir.join("polygons.json"))?)?;
+    let Some(vertices) = truth["polygons"][0]["vertices"].as_array() else {
+        return Ok(false);
+    };
+    let vertices: Vec<(f64, f64)> = vertices
+        .iter()
+        .filter_map(|v| Some((v[0].as_f64()?, v[1].as_f64()?)))
+        .collect();
+    let reader = CarmenReader::open(&set.dir.join("polygons.log"))?;
+    let Some(scan) = reader.flatten().find_map(|r| match r {
+        Record::Laser(laser) => Some(laser),
+        _ => None,
+    }) else {
+        return Ok(false);
+    };
+    let points: Vec<(f64, f64)> = scan
+        .scan
+        .points(scan.world_from_laser)
+        .map(|p| (p.x, p.y))
+        .collect();
+    let mut bounds = points.clone();
+    bounds.extend(&vertices);
+    let Some(mut top) = TopDown::fit(&bounds, 0.0, 0.01, 600.0) else {
+        return Ok(false);
+    };
+    for (i, &a) in vertices.iter().enumerate() {
+        top.line(a, vertices[(i + 1) % vertices.len()], [40, 90, 200]);
+    }
+    for &(x, y) in &points {
+        top.dot(x, y, 1, [220, 40, 40]);
+    }
+    top.dot(0.0, 0.0, 3, [0, 0, 0]);
+    top.save(path)?;
+    Ok(true)
+}
+
+fn log_picture(log: &Path, path: &Path) -> Result<bool> {
+    let reader = CarmenReader::open(log)?;
+    let mut hits = Vec::new();
+    let mut trajectory = Vec::new();
+    for record in reader.flatten() {
+        if let Record::Laser(laser) = record {
+            trajectory.push((laser.world_from_laser.x(), laser.world_from_laser.y()));
+            hits.extend(
+                laser
+                    .scan
+                    .points(laser.world_from_laser)
+                    .map(|p| (p.x, p.y)),
+            );
+        }
+    }
+    let Some(mut top) = TopDown::fit(&hits, 0.001, 0.05, 900.0) else {
+        return Ok(false);
+    };
+    for &(x, y) in &hits {
+        top.hit(x, y);
+    }
+    for pair in trajectory.windows(2) {
+        top.line(pair[0], pair[1], [220, 40, 40]);
+    }
+    top.save(path)?;
+    Ok(true)
+}
+
+fn synpeb_picture(set: &SetOnDisk, path: &Path) -> Result<bool> {
+    let Some(file) = first_file(set, "test/", ".pcd") else {
+        return Ok(false);
+    };
+    let read = pcd::read_pcd(&set.dir.join(file), &ReadOptions::synpeb())?;
+    let cloud = &read.cloud;
+    let (w, h) = (cloud.width as u32, cloud.height as u32);
+    let mut image = image::RgbImage::new(2 * w, h);
+    let labels = cloud.label.clone().unwrap_or_default();
+    for row in 0..h {
+        for col in 0..w {
+            let i = (row * w + col) as usize;
+            let p = cloud.points[i];
+            let range = f64::from(p.coords.norm());
+            let color = if range.is_finite() {
+                colormap(range / 8.0)
+            } else {
+                [0, 0, 0]
+            };
+            image.put_pixel(col, row, image::Rgb(color));
+            let label = labels.get(i).copied().unwrap_or(0);
+            image.put_pixel(w + col, row, image::Rgb(label_color(label)));
+        }
+    }
+    image
+        .save(path)
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(true)
+}
+
+fn first_file<'a>(set: &'a SetOnDisk, prefix: &str, suffix: &str) -> Option<&'a str> {
+    set.info["files"]
+        .as_array()?
+        .iter()
+        .filter_map(|f| f["path"].as_str())
+        .find(|p| p.starts_with(prefix) && p.ends_with(suffix))
+}
+
+/// The sequence directory of a KITTI-layout set (`sequences/NN`).
+fn sequence_dir(set: &SetOnDisk) -> Option<PathBuf> {
+    let sequences = set.dir.join("sequences");
+    let mut entries: Vec<_> = std::fs::read_dir(&sequences)
+        .ok()?
+        .flatten()
+        .map(|e| e.path())
+        .collect();
+    entries.sort();
+    entries.into_iter().find(|p| p.is_dir())
+}
+
+fn kitti_top_down(set: &SetOnDisk, path: &Path) -> Result<bool> {
+    let Some(dir) = sequence_dir(set) else {
+        return Ok(false);
+    };
+    let sequence = KittiSequence::open(&dir)?;
+    let Some(cam0_from_velo) = sequence.calib()?.and_then(|c| c.cam0_from_velo()) else {
+        return Ok(false);
+    };
+    let world_from_velo = kitti::velodyne_poses_from_cam0(&sequence.poses()?, &cam0_from_velo);
+    let mut hits = Vec::new();
+    for (i, scan) in sequence.scans().enumerate().step_by(5) {
+        let scan = scan?;
+        let Some(pose) = world_from_velo.get(i) else {
+            break;
+        };
+        for p in scan.points.points.iter().step_by(4) {
+            let q = pose.transform_point(&p.cast::<f64>());
+            hits.push((q.x, q.y));
+        }
+    }
+    let poles = raypath_io::point_csv::PointCsv::read(&dir.join("poles.csv"))
+        .map(|csv| csv.points().iter().map(|p| (p.x, p.y)).collect::<Vec<_>>())
+        .unwrap_or_default();
+    let Some(mut top) = TopDown::fit(&hits, 0.002, 0.1, 1200.0) else {
+        return Ok(false);
+    };
+    for &(x, y) in &hits {
+        top.hit(x, y);
+    }
+    for pair in world_from_velo.windows(2) {
+        let (a, b) = (pair[0].translation(), pair[1].translation());
+        top.line((a.x, a.y), (b.x, b.y), [220, 40, 40]);
+    }
+    for &(x, y) in &poles {
+        top.dot(x, y, 2, [40, 90, 200]);
+    }
+    top.save(path)?;
+    Ok(true)
+}
+
+fn kitti_range_image(set: &SetOnDisk, path: &Path) -> Result<bool> {
+    let Some(dir) = sequence_dir(set) else {
+        return Ok(false);
+    };
+    let sequence = KittiSequence::open(&dir)?;
+    let Some(scan) = sequence.scans().next() else {
+        return Ok(false);
+    };
+    let cloud = scan?.points;
+    // One row per laser: each point goes to the laser of nearest elevation (the HDL-64E's
+    // elevations are not evenly spaced, so a uniform spherical grid would leave empty rows).
+    let mut elevations = raypath_sim::lidar3::Lidar3::hdl64e().elevations_rad;
+    elevations.sort_by(|a, b| b.total_cmp(a));
+    let (rows, cols, scale) = (elevations.len(), 1024usize, 4usize);
+    let mut nearest = vec![f64::INFINITY; rows * cols];
+    for p in &cloud.points {
+        let (x, y, z) = (f64::from(p.x), f64::from(p.y), f64::from(p.z));
+        let range = (x * x + y * y + z * z).sqrt();
+        if !range.is_finite() || range == 0.0 {
+            continue;
+        }
+        let elevation = z.atan2(x.hypot(y));
+        let row = elevations
+            .iter()
+            .enumerate()
+            .min_by(|a, b| (a.1 - elevation).abs().total_cmp(&(b.1 - elevation).abs()))
+            .map_or(0, |(i, _)| i);
+        // Column 0 looks backwards-left, the middle forwards (azimuth decreasing to the right).
+        let azimuth = y.atan2(x);
+        let col =
+            (((std::f64::consts::PI - azimuth) / std::f64::consts::TAU) * cols as f64) as usize;
+        let cell = &mut nearest[row * cols + col.min(cols - 1)];
+        *cell = cell.min(range);
+    }
+    let mut png = image::RgbImage::new(cols as u32, (rows * scale) as u32);
+    for row in 0..rows {
+        for col in 0..cols {
+            let r = nearest[row * cols + col];
+            let color = if r.is_finite() {
+                colormap((r / 60.0).sqrt())
+            } else {
+                [0, 0, 0]
+            };
+            for k in 0..scale {
+                png.put_pixel(col as u32, (row * scale + k) as u32, image::Rgb(color));
+            }
+        }
+    }
+    png.save(path)
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(true)
+}
