@@ -7,32 +7,92 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Location, Result};
 
-/// How a file is compressed, recognized by its first bytes (not by its name).
+/// How a file is compressed.
+///
+/// gzip and bzip2 are recognized by their first bytes (so a `.log` that is really gzip still
+/// reads), with magic numbers long enough that raw sensor data cannot imitate them. Two
+/// exceptions protect binary scans, whose first bytes are arbitrary floats or integers (see
+/// [`Compression::detect`]): files named `*.bin` are never decompressed, and Unix `compress`,
+/// whose magic is only two bytes, is recognized only in files named `*.Z`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Compression {
     /// Plain bytes.
     None,
-    /// gzip (`1f 8b`), as in `.log.gz`.
+    /// gzip (`1f 8b 08`), as in `.log.gz`.
     Gzip,
-    /// bzip2 (`BZh`), as in `.clf.bz2`.
+    /// bzip2 (`BZh1`–`BZh9` and a block or end-of-stream marker), as in `.clf.bz2`.
     Bzip2,
     /// Unix `compress` (`1f 9d`, LZW), as in SegComp's `.Z` files.
     Compress,
 }
 
+/// The bzip2 block-header and end-of-stream markers (BCD π and √π).
+const BZIP2_BLOCK: [u8; 6] = [0x31, 0x41, 0x59, 0x26, 0x53, 0x59];
+const BZIP2_END: [u8; 6] = [0x17, 0x72, 0x45, 0x38, 0x50, 0x90];
+
 impl Compression {
-    /// Recognizes the compression from the first bytes of a file.
+    /// Recognizes the compression from the first bytes alone: gzip needs `1f 8b 08` with the
+    /// reserved flag bits clear, bzip2 `BZh1`–`BZh9` and a block or end-of-stream marker, Unix
+    /// compress `1f 9d` and a valid flags byte.
     pub fn sniff(head: &[u8]) -> Self {
-        if head.starts_with(&[0x1f, 0x8b]) {
+        if head.len() >= 4 && head.starts_with(&[0x1f, 0x8b, 0x08]) && head[3] & 0xe0 == 0 {
             Compression::Gzip
-        } else if head.len() >= 4 && head.starts_with(b"BZh") && head[3].is_ascii_digit() {
+        } else if head.len() >= 10
+            && head.starts_with(b"BZh")
+            && (b'1'..=b'9').contains(&head[3])
+            && (head[4..10] == BZIP2_BLOCK || head[4..10] == BZIP2_END)
+        {
             Compression::Bzip2
-        } else if crate::lzw::is_compressed(head) {
+        } else if head.len() >= 3
+            && crate::lzw::is_compressed(head)
+            && (9..=16).contains(&(head[2] & 0x1f))
+            && head[2] & 0x60 == 0
+        {
             Compression::Compress
         } else {
             Compression::None
         }
     }
+
+    /// The compression of the file `path` that starts with `head`: as [`Compression::sniff`],
+    /// except that `*.bin` files (raw binary scans) are never compressed and Unix compress needs
+    /// the `.Z` suffix.
+    pub fn detect(path: &Path, head: &[u8]) -> Self {
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        if name.ends_with(".bin") {
+            return Compression::None;
+        }
+        match Self::sniff(head) {
+            Compression::Compress if !name.ends_with(".z") => Compression::None,
+            other => other,
+        }
+    }
+}
+
+/// The file's length in bytes when it is stored uncompressed (so the length bounds what its
+/// records can claim), `None` when it is compressed.
+pub fn plain_len(path: &Path) -> Result<Option<u64>> {
+    let mut file = File::open(path).map_err(|e| Error::io(path, Location::File, e))?;
+    let mut head = [0u8; 16];
+    let mut n = 0;
+    while n < head.len() {
+        match file.read(&mut head[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(Error::io(path, Location::Byte(n as u64), e)),
+        }
+    }
+    if Compression::detect(path, &head[..n]) != Compression::None {
+        return Ok(None);
+    }
+    let meta = file
+        .metadata()
+        .map_err(|e| Error::io(path, Location::File, e))?;
+    Ok(Some(meta.len()))
 }
 
 /// The first bytes of a file (at most `n`) after decompression, for format detection.
@@ -58,7 +118,7 @@ pub fn open(path: &Path) -> Result<Box<dyn BufRead + Send>> {
     let head = reader
         .fill_buf()
         .map_err(|e| Error::io(path, Location::Byte(0), e))?;
-    Ok(match Compression::sniff(head) {
+    Ok(match Compression::detect(path, head) {
         Compression::None => Box::new(reader),
         Compression::Gzip => Box::new(BufReader::with_capacity(
             1 << 16,
@@ -314,13 +374,45 @@ mod tests {
 
     #[test]
     fn sniff_compression() {
-        assert_eq!(Compression::sniff(&[0x1f, 0x8b, 8]), Compression::Gzip);
-        assert_eq!(Compression::sniff(b"BZh9"), Compression::Bzip2);
+        assert_eq!(Compression::sniff(&[0x1f, 0x8b, 8, 0]), Compression::Gzip);
+        assert_eq!(Compression::sniff(&[0x1f, 0x8b, 7, 0]), Compression::None);
+        let mut bz = b"BZh9".to_vec();
+        bz.extend_from_slice(&BZIP2_BLOCK);
+        assert_eq!(Compression::sniff(&bz), Compression::Bzip2);
+        assert_eq!(Compression::sniff(b"BZh9abcdef"), Compression::None);
         assert_eq!(Compression::sniff(b"BZhx"), Compression::None);
         assert_eq!(Compression::sniff(b"FLASER"), Compression::None);
         assert_eq!(
             Compression::sniff(&[0x1f, 0x9d, 0x90]),
             Compression::Compress
+        );
+        assert_eq!(Compression::sniff(&[0x1f, 0x9d, 0x02]), Compression::None);
+    }
+
+    #[test]
+    fn binary_scans_are_never_taken_for_compressed_files() {
+        // A KITTI scan whose first float happens to start with the bytes of a magic number.
+        let head = [0x1f, 0x9d, 0x90, 0x41, 0, 0, 0, 0];
+        assert_eq!(
+            Compression::detect(Path::new("000075.bin"), &head),
+            Compression::None
+        );
+        assert_eq!(
+            Compression::detect(Path::new("scan.dat"), &head),
+            Compression::None
+        );
+        assert_eq!(
+            Compression::detect(Path::new("perc.test.1.Z"), &head),
+            Compression::Compress
+        );
+        let gz = [0x1f, 0x8b, 8, 0];
+        assert_eq!(
+            Compression::detect(Path::new("000001.bin"), &gz),
+            Compression::None
+        );
+        assert_eq!(
+            Compression::detect(Path::new("intel.log"), &gz),
+            Compression::Gzip
         );
     }
 

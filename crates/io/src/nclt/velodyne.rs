@@ -146,12 +146,7 @@ pub struct HitsReader<R> {
 impl HitsReader<Box<dyn BufRead + Send>> {
     /// Opens a packet stream (plain or compressed).
     pub fn open(path: &Path) -> Result<Self> {
-        let head = source::peek(path, 4)?;
-        let len = if source::Compression::sniff(&head) == source::Compression::None {
-            std::fs::metadata(path).ok().map(|m| m.len())
-        } else {
-            None
-        };
+        let len = source::plain_len(path)?;
         Ok(Self::new(source::open(path)?, path, len))
     }
 }

@@ -19,15 +19,14 @@
 //! OctoMap read and write back bit for bit.
 
 use std::collections::HashSet;
-use std::fs::File;
 use std::io::{BufRead, Read};
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Point3, Quaternion, UnitQuaternion, Vector3};
 use raypath_geometry::{PointCloud, Pose3};
 
-use crate::source::{self, ByteReader, Compression};
-use crate::{Error, Location, Result};
+use crate::Result;
+use crate::source::{self, ByteReader};
 
 /// Bytes of one point in the file (`i32` dimension + 3 × `f64`).
 pub(super) const POINT_BYTES: u64 = 28;
@@ -114,19 +113,7 @@ pub struct ScanGraphReader<R> {
 impl ScanGraphReader<Box<dyn BufRead + Send>> {
     /// Opens a `.graph` file (plain or compressed) and reads its node count.
     pub fn open(path: &Path) -> Result<Self> {
-        let mut head = [0u8; 4];
-        let mut file = File::open(path).map_err(|e| Error::io(path, Location::File, e))?;
-        let n = file
-            .read(&mut head)
-            .map_err(|e| Error::io(path, Location::Byte(0), e))?;
-        let len = if Compression::sniff(&head[..n]) == Compression::None {
-            let meta = file
-                .metadata()
-                .map_err(|e| Error::io(path, Location::File, e))?;
-            Some(meta.len())
-        } else {
-            None
-        };
+        let len = source::plain_len(path)?;
         Self::new(source::open(path)?, path, len)
     }
 }
