@@ -75,7 +75,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         "files",
         "MB",
         "mode",
-        "read by raypath-io",
+        "raypath info",
     ]);
     let mut readability = Vec::new();
     for set in &sets {
