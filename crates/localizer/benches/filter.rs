@@ -1,0 +1,2 @@
+//! Filter update rate (placeholder, replaced below).
+fn main() {}
