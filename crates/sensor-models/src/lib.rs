@@ -5,6 +5,7 @@ mod dimension;
 pub mod edt;
 mod error;
 mod models;
+mod optical_depth;
 mod reading;
 mod scan;
 mod stats;
@@ -12,6 +13,7 @@ mod stats;
 pub use dimension::{Crossing, Dimension, Planar, Spatial};
 pub use error::SensorModelError;
 pub use models::*;
+pub use optical_depth::{OpticalDepthConfig, OpticalDepthTable, Tabulated};
 pub use reading::{Reading, SensorRange};
 pub use scan::{PreparedScan, ScanLikelihood};
 pub use stats::{

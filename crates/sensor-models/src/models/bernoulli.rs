@@ -7,7 +7,7 @@ use crate::{Reading, SensorRange};
 
 /// Smallest chord used in the density conversion (Eq. 7.32), as a fraction of the cell
 /// edge: a ray that only grazes a cell's corner would otherwise divide by zero.
-const MIN_CHORD_FRACTION: f64 = 1e-6;
+pub(crate) const MIN_CHORD_FRACTION: f64 = 1e-6;
 
 /// A grid of per-cell reflection probabilities `μ_i` with the ray likelihood of the
 /// reflection model (Hähnel et al. 2003; Schaefer 2020, Eq. 7.23 and 7.32):
@@ -87,6 +87,11 @@ impl<D: Dimension> BernoulliField<D> {
     /// `μ₀`, the reflection probability of unobserved space outside the grid.
     pub fn outside_probability(&self) -> f64 {
         self.outside_probability
+    }
+
+    /// Per cell `[ln μ_i, ln(1 − μ_i)]`.
+    pub(crate) fn log_probs(&self) -> &[[f64; 2]] {
+        &self.log_probs
     }
 
     /// The range limits.

@@ -1,6 +1,6 @@
 //! Sensor models: per-ray log-likelihoods on a map, behind one trait.
 
-mod bernoulli;
+pub(crate) mod bernoulli;
 mod decay_rate;
 mod decay_rate_posterior;
 mod likelihood_field;
