@@ -23,7 +23,7 @@ use rand_distr::{Distribution, StandardNormal};
 use raypath_geometry::{Pose2, Pose3, wrap_angle};
 use serde::{Deserialize, Serialize};
 
-use crate::error::{LocalizerError, require_non_negative, require_positive};
+use crate::error::{LocalizerError, require_non_negative};
 
 /// A distribution initial particles are drawn from.
 pub trait Initializer<S>: Sync {
@@ -252,12 +252,12 @@ impl Initializer<Pose2> for UniformBox {
                     reason: format!("bounds must be finite, got [{lo}, {hi}]"),
                 });
             }
-            require_positive(name, hi - lo + f64::MIN_POSITIVE).map_err(|_| {
-                LocalizerError::InvalidParameter {
+            if lo > hi {
+                return Err(LocalizerError::InvalidParameter {
                     name,
                     reason: format!("need min <= max, got [{lo}, {hi}]"),
-                }
-            })?;
+                });
+            }
         }
         Ok(())
     }
