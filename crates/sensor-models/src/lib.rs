@@ -4,6 +4,7 @@
 mod dimension;
 pub mod edt;
 mod error;
+pub mod export;
 mod models;
 mod optical_depth;
 mod reading;

@@ -182,6 +182,31 @@ impl DenseStats<Spatial> {
         Self::new(grid)
     }
 
+    /// The statistics summed over each vertical column (`H`, `M`, `R` added over z): a 2-D
+    /// map of the same x–y grid, e.g. for pictures of a 3-D map.
+    pub fn project_z(&self) -> DenseStats2 {
+        let [nx, ny, nz] = self.grid.dims();
+        let origin = self.grid.origin();
+        let mut cells = vec![CellStats::EMPTY; nx * ny];
+        for z in 0..nz {
+            let layer = self.cells.get(z * nx * ny..(z + 1) * nx * ny).unwrap_or_default();
+            for (into, from) in cells.iter_mut().zip(layer) {
+                into.merge(from);
+            }
+        }
+        let grid = Grid2::new(
+            nalgebra::Point2::new(origin.x, origin.y),
+            self.grid.cell_size(),
+            [nx, ny],
+        )
+        .expect("the x-y grid of a valid 3-D grid is valid");
+        DenseStats2 {
+            grid,
+            cells,
+            summary: self.summary,
+        }
+    }
+
     /// Inserts point clouds given in the sensor frame, each with its `world_from_sensor`
     /// pose, in parallel: every valid point is a return along the ray from the sensor
     /// origin. Missing points (NaN) are skipped (their direction is unknown), as are points
