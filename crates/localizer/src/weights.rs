@@ -12,8 +12,27 @@
 //! log-likelihoods (a 3-D scan easily sums to −10⁵), and the result is invariant to adding a
 //! constant to every lᵢ. The effective sample size (Kong et al. 1994; Thrun et al. §4.3.4)
 //! of normalized weights is `ESS = 1 / Σᵢ wᵢ²`, between 1 and N.
+//!
+//! Large sets are processed in parallel; sums run over fixed chunks, so the result is
+//! bit-identical on any number of threads.
+
+use rayon::prelude::*;
 
 use crate::error::LocalizerError;
+
+/// Sums run over fixed chunks of this many entries (in parallel), then over the chunk sums in
+/// order: the rounding depends on the length only, never on the number of threads.
+const CHUNK: usize = 2048;
+
+/// Σᵢ f(vᵢ), deterministic for a given length whatever the thread count (see [`CHUNK`]).
+fn chunked_sum(values: &[f64], f: impl Fn(f64) -> f64 + Sync) -> f64 {
+    let chunk_sum = |chunk: &[f64]| chunk.iter().map(|&v| f(v)).sum::<f64>();
+    if values.len() <= CHUNK {
+        return 0.0 + chunk_sum(values);
+    }
+    let partials: Vec<f64> = values.par_chunks(CHUNK).map(chunk_sum).collect();
+    partials.iter().sum()
+}
 
 /// ln Σᵢ e^{lᵢ}, computed stably. `−∞` when every entry is `−∞` or the slice is empty.
 /// NaN entries propagate (check before calling).
@@ -64,8 +83,14 @@ pub fn normalize_log_weights(log_weights: &mut [f64]) -> Result<f64, LocalizerEr
     }
     // (lᵢ − m) first: exact for nearby values however large m is, so the weights of a
     // −10⁵ scan likelihood keep full relative precision.
-    for l in log_weights.iter_mut() {
-        *l = (*l - max) - ln_sum;
+    let subtract = |l: &mut f64| *l = (*l - max) - ln_sum;
+    if log_weights.len() <= CHUNK {
+        log_weights.iter_mut().for_each(subtract);
+    } else {
+        log_weights
+            .par_iter_mut()
+            .with_min_len(CHUNK)
+            .for_each(subtract);
     }
     Ok(max + ln_sum)
 }
@@ -73,10 +98,7 @@ pub fn normalize_log_weights(log_weights: &mut [f64]) -> Result<f64, LocalizerEr
 /// The effective sample size `1 / Σᵢ wᵢ²` of **normalized** log-weights
 /// (see [`normalize_log_weights`]).
 pub fn effective_sample_size(normalized_log_weights: &[f64]) -> f64 {
-    let sum_sq: f64 = normalized_log_weights
-        .iter()
-        .map(|&l| (2.0 * l).exp())
-        .sum();
+    let sum_sq = chunked_sum(normalized_log_weights, |l| (2.0 * l).exp());
     if sum_sq > 0.0 { 1.0 / sum_sq } else { 0.0 }
 }
 

@@ -152,13 +152,14 @@ fn bits(filter: &ParticleFilter<Pose2>) -> Vec<u64> {
 
 #[test]
 fn deterministic_per_seed_and_across_thread_counts() {
-    let run_with = |threads: usize, seed: u64| {
+    let run_with_particles = |threads: usize, seed: u64, particles: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap();
-        pool.install(|| run_planar(seed, 1000, FilterConfig::default(), 15))
+        pool.install(|| run_planar(seed, particles, FilterConfig::default(), 15))
     };
+    let run_with = |threads: usize, seed: u64| run_with_particles(threads, seed, 1000);
     let one = run_with(1, 11);
     let two = run_with(2, 11);
     let again = run_with(2, 11);
@@ -166,6 +167,14 @@ fn deterministic_per_seed_and_across_thread_counts() {
     assert_eq!(bits(&one), bits(&two), "1 vs 2 threads differ");
     assert_eq!(bits(&two), bits(&again));
     assert_ne!(bits(&two), bits(&other));
+    // More particles than one summation chunk (2048): parallel normalization and ESS.
+    let big_one = run_with_particles(1, 13, 5000);
+    let big_two = run_with_particles(2, 13, 5000);
+    assert_eq!(
+        bits(&big_one),
+        bits(&big_two),
+        "5000 particles: 1 vs 2 threads differ"
+    );
     // KLD-sampling (sequential draws) is deterministic too.
     let kld = FilterConfig {
         kld: Some(KldConfig::default()),

@@ -30,6 +30,9 @@
 
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
+use std::f64::consts::PI;
+
+use nalgebra::{Isometry2, UnitComplex, Vector2};
 use raypath_geometry::{Pose2, wrap_angle};
 use serde::{Deserialize, Serialize};
 
@@ -82,8 +85,13 @@ impl OdometryMotionModel {
     /// components of `control` (module docs).
     pub fn noise_std(&self, control: &OdometryControl) -> [f64; 3] {
         let fold = |a: f64| {
-            let a = wrap_angle(a).abs();
-            a.min(std::f64::consts::PI - a)
+            // Controls from `from_poses` are wrapped already; skip the costly fmod then.
+            let a = if a.abs() <= PI {
+                a.abs()
+            } else {
+                wrap_angle(a).abs()
+            };
+            a.min(PI - a)
         };
         let r1 = fold(control.rot1_rad);
         let r2 = fold(control.rot2_rad);
@@ -150,13 +158,14 @@ impl MotionModel<Pose2> for OdometryMotionModel {
         let rot1 = control.rot1_rad - s_rot1 * n1;
         let trans = control.trans_m - s_trans * n2;
         let rot2 = control.rot2_rad - s_rot2 * n3;
-        let heading = state.theta() + rot1;
-        let (sin, cos) = heading.sin_cos();
-        Pose2::new(
-            state.x() + trans * cos,
-            state.y() + trans * sin,
-            wrap_angle(heading + rot2),
-        )
+        // Rotations as unit complex numbers: two sin/cos, no atan2 or angle wrapping.
+        let heading = state.isometry.rotation * UnitComplex::new(rot1);
+        let direction = Vector2::new(heading.cos_angle(), heading.sin_angle());
+        let translation = state.translation() + trans * direction;
+        Pose2::from(Isometry2::from_parts(
+            translation.into(),
+            heading * UnitComplex::new(rot2),
+        ))
     }
 }
 
@@ -181,7 +190,7 @@ mod tests {
     #[test]
     fn backward_motion_is_not_a_half_turn() {
         let control = OdometryControl::from_increment(&Pose2::new(-1.0, 0.0, 0.0));
-        assert!((control.rot1_rad.abs() - std::f64::consts::PI).abs() < 1e-12);
+        assert!((control.rot1_rad.abs() - PI).abs() < 1e-12);
         let std = OdometryMotionModel::default().noise_std(&control);
         // Only translation contributes: √(α2 · 1²) for the rotations.
         assert!((std[0] - 0.2f64.sqrt()).abs() < 1e-9);
