@@ -41,7 +41,9 @@ pub struct FilterConfig {
     /// Resample when ESS / N falls below this ratio, in (0, 1]. Default 0.5 (Schaefer 2020,
     /// ch. 12). 1.0 resamples after every update that leaves the weights non-uniform.
     pub resample_ess_ratio: f64,
-    /// KLD-sampling; `None` (default) keeps the particle count fixed.
+    /// KLD-sampling; `None` (default) keeps the particle count fixed. It acts whenever the
+    /// filter resamples; set `resample_ess_ratio` to 1 to resample (and so adapt N) after
+    /// every update, as AMCL does.
     pub kld: Option<KldConfig>,
     /// Fewest particles per rayon task (amortizes scheduling for cheap models). Default 64.
     pub min_particles_per_task: usize,
