@@ -28,7 +28,7 @@ pub struct LikelihoodFieldConfig {
     pub max_distance_m: f64,
     /// Absolute probability `P` of a no-return (`sup`).
     pub no_return_probability: f64,
-    /// Absolute probability of a `sub` reading.
+    /// Absolute probability of a `sub` reading (used when `r_min > 0`).
     pub sub_probability: f64,
     /// Normalize per ray to a density (see [`LikelihoodFieldModel`]); `false` returns
     /// AMCL's raw value `ln q(endpoint)`.
@@ -100,6 +100,9 @@ impl LikelihoodFieldConfig {
 /// p(r | s, m) = (1 − P_sup − P_sub) · q(x(r)) / ∫_{r_min}^{r_max} q(x(r')) dr'
 /// P(sup) = P_sup,  P(sub) = P_sub
 /// ```
+///
+/// (`P_sub` counts only when `r_min > 0`; with `r_min = 0` the in-range mass is `1 − P_sup`,
+/// and a negative range, which no sensor reports, is still scored `ln P_sub`.)
 ///
 /// `q` is piecewise constant on cells, so the integral is `Σ_i q_i d_i` over the cells the
 /// ray's line crosses in `[r_min, r_max]` (exact traversal; outside the grid
@@ -189,6 +192,15 @@ impl<D: Dimension> LikelihoodFieldModel<D> {
         integral + self.outside_value * ((hi - lo) - inside).max(0.0)
     }
 
+    /// The probability of `sub` readings: `sub_probability` when `r_min > 0`, else 0.
+    fn sub_mass(&self) -> f64 {
+        if self.config.range.min_range_m > 0.0 {
+            self.config.sub_probability
+        } else {
+            0.0
+        }
+    }
+
     /// The log-likelihood given the normalizer (`None`: unnormalized AMCL value).
     #[inline]
     pub(crate) fn log_likelihood_with(&self, reading: Reading, q: f64, normalizer: Option<f64>) -> f64 {
@@ -196,7 +208,7 @@ impl<D: Dimension> LikelihoodFieldModel<D> {
         let value = match reading {
             Reading::Hit(_) => match normalizer {
                 Some(z) => {
-                    let mass = 1.0 - config.no_return_probability - config.sub_probability;
+                    let mass = 1.0 - config.no_return_probability - self.sub_mass();
                     mass.ln() + q.ln() - z.ln()
                 }
                 None => q.ln(),
