@@ -95,6 +95,25 @@
 //! * [`init::GaussianInit`]: σ 1 m horizontal, 0.2 m vertical, 0.1 rad (thesis ch. 7).
 //! * [`eval::EvaluationConfig`]: spacing 1 m, divergence threshold 5 m.
 //!
+//! ## Performance
+//!
+//! `cargo bench -p raypath-localizer --bench filter` (criterion; synthetic model of 8 beacon
+//! ranges, odometry motion model, resampling every step; one core of the 2-core development
+//! machine):
+//!
+//! | state | particles | predict | update | resample | full step | steps/s |
+//! | --- | --- | --- | --- | --- | --- | --- |
+//! | SE(2) | 1000 | 54 µs | 34 µs | 14.5 µs | 109 µs | ≈ 9 200 |
+//! | SE(2) | 5000 | 270 µs | 165 µs | 71 µs | 550 – 590 µs | ≈ 1 750 |
+//! | SE(3) | 1000 | | | | 144 µs | ≈ 6 900 |
+//! | SE(3) | 5000 | | | | 710 – 760 µs | ≈ 1 350 |
+//!
+//! Per particle that is ≈ 54 ns to predict (random stream, three normal draws, two sin/cos),
+//! ≈ 33 ns to weight (most of it the 8 ranges) and ≈ 14 ns to resample, so 5000 particles
+//! at 50 Hz (issue 8's pole-landmark target) spend about 3 % of the 20 ms budget in the
+//! filter. Prediction and weighting scale with rayon (≈ 1.75× on 2 cores when the second
+//! core is free); normalization and resampling are O(N) and partly sequential.
+//!
 //! Units and frames: metres, radians, seconds; REP-103 (x forward, y left, z up). Poses are
 //! `world_from_robot`.
 

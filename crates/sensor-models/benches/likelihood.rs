@@ -1,1 +1,3 @@
+//! Ray-likelihood throughput (placeholder until the likelihood benchmark lands).
+
 fn main() {}

@@ -8,9 +8,7 @@
 use std::fmt::Debug;
 
 use nalgebra::{Point2, Point3};
-use raypath_geometry::{
-    CellCrossing, Grid2, Grid3, Range, Ray2, Ray3, Traversal2, Traversal3,
-};
+use raypath_geometry::{CellCrossing, Grid2, Grid3, Range, Ray2, Ray3, Traversal2, Traversal3};
 
 mod sealed {
     pub trait Sealed {}

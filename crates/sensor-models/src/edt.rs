@@ -121,7 +121,9 @@ mod tests {
         let mut state = 12345u64;
         let sites: Vec<bool> = (0..n)
             .map(|_| {
-                state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
                 (state >> 60) == 0
             })
             .collect();
@@ -133,7 +135,7 @@ mod tests {
                 (i / (dims[0] * dims[1])) as f64,
             ]
         };
-        for i in 0..n {
+        for (i, &got) in edt.iter().enumerate() {
             let a = coords(i);
             let best = (0..n)
                 .filter(|&j| sites[j])
@@ -142,15 +144,17 @@ mod tests {
                     (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)
                 })
                 .fold(f64::INFINITY, f64::min);
-            assert_eq!(edt[i], best, "cell {i}");
+            assert_eq!(got, best, "cell {i}");
         }
     }
 
     #[test]
     fn no_sites_and_2d() {
-        assert!(squared_distance_transform([3, 3, 1], &[false; 9])
-            .iter()
-            .all(|d| d.is_infinite()));
+        assert!(
+            squared_distance_transform([3, 3, 1], &[false; 9])
+                .iter()
+                .all(|d| d.is_infinite())
+        );
         let mut sites = [false; 12];
         sites[0] = true;
         let edt = squared_distance_transform([4, 3, 1], &sites);

@@ -125,7 +125,10 @@ impl<M: SensorModel<Spatial>> ScanLikelihood<M> {
             .step_by(self.beam_step)
             .filter(|&i| cloud.is_valid(i))
             .filter_map(|i| {
-                Ray3::between(origin, world_from_sensor.transform_point(&cloud.point_f64(i)))
+                Ray3::between(
+                    origin,
+                    world_from_sensor.transform_point(&cloud.point_f64(i)),
+                )
             })
             .map(|ray| self.model.ray_log_likelihood(&ray))
             .sum()

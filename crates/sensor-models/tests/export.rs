@@ -1,4 +1,5 @@
 //! Map export: binary round trip, no panics on mutated files, PGM/YAML and PNG contents.
+#![allow(clippy::unwrap_used)] // test code: a panic is the failure report
 
 use nalgebra::{Point2, Point3, Vector3};
 use proptest::prelude::*;
@@ -15,8 +16,15 @@ fn small_map_2d() -> DenseStats2 {
     let config = MappingConfig::default();
     for i in 0..40 {
         let angle = f64::from(i) * 0.15;
-        let range = if i % 7 == 0 { Range::NoReturn } else { Range::Hit(0.3 + 0.05 * f64::from(i)) };
-        stats.insert_ray(&Ray2::from_angle(Point2::new(0.4, 0.1), angle, range), &config);
+        let range = if i % 7 == 0 {
+            Range::NoReturn
+        } else {
+            Range::Hit(0.3 + 0.05 * f64::from(i))
+        };
+        stats.insert_ray(
+            &Ray2::from_angle(Point2::new(0.4, 0.1), angle, range),
+            &config,
+        );
     }
     stats
 }
@@ -41,12 +49,19 @@ fn binary_round_trip_2d_and_3d() {
 
     let grid = Grid3::new(Point3::new(0.0, 0.0, 0.0), 0.5, [6, 5, 4]).unwrap();
     let mut stats = DenseStats3::new(grid);
-    let ray = Ray3::new(Point3::new(0.2, 0.3, 0.4), Vector3::new(1.0, 0.7, 0.3), Range::Hit(2.2));
+    let ray = Ray3::new(
+        Point3::new(0.2, 0.3, 0.4),
+        Vector3::new(1.0, 0.7, 0.3),
+        Range::Hit(2.2),
+    );
     stats.insert_ray(&ray.unwrap(), &MappingConfig::default());
     let file3 = MapFile {
         kind: MapKind::Reflection,
         posterior: false,
-        mapping: MappingConfig { include_no_returns: false, ..Default::default() },
+        mapping: MappingConfig {
+            include_no_returns: false,
+            ..Default::default()
+        },
         stats: StoredStats::Spatial(stats),
     };
     let dir = tempfile::tempdir().unwrap();
@@ -58,8 +73,13 @@ fn binary_round_trip_2d_and_3d() {
 #[test]
 fn clear_errors_with_offsets() {
     let bytes = small_file().to_bytes();
-    let check = |bytes: &[u8], offset: u64, needle: &str| match MapFile::from_bytes(bytes, "m.rpm") {
-        Err(SensorModelError::Format { name, offset: at, reason }) => {
+    let check = |bytes: &[u8], offset: u64, needle: &str| match MapFile::from_bytes(bytes, "m.rpm")
+    {
+        Err(SensorModelError::Format {
+            name,
+            offset: at,
+            reason,
+        }) => {
             assert_eq!(name, "m.rpm");
             assert_eq!(at, offset, "{reason}");
             assert!(reason.contains(needle), "{reason}");
@@ -92,7 +112,11 @@ fn crc32(bytes: &[u8]) -> u32 {
     for &b in bytes {
         c ^= u32::from(b);
         for _ in 0..8 {
-            c = if c & 1 != 0 { 0xEDB8_8320 ^ (c >> 1) } else { c >> 1 };
+            c = if c & 1 != 0 {
+                0xEDB8_8320 ^ (c >> 1)
+            } else {
+                c >> 1
+            };
         }
     }
     !c
@@ -169,7 +193,10 @@ fn ros_map_and_png() {
         "free_thresh: 0.196",
         "mode: trinary",
     ] {
-        assert!(yaml_text.lines().any(|l| l == line), "missing {line:?} in\n{yaml_text}");
+        assert!(
+            yaml_text.lines().any(|l| l == line),
+            "missing {line:?} in\n{yaml_text}"
+        );
     }
     let png = dir.path().join("intel.png");
     let decay = picture_values(&stats, MapPicture::DecayRate);

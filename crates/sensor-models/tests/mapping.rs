@@ -1,5 +1,6 @@
 //! Map building (MAP-DECAY, Schaefer 2020 Sec. 7.4.2): known answers, edge cases, dense vs
 //! sparse, and determinism of the parallel build.
+#![allow(clippy::unwrap_used)] // test code: a panic is the failure report
 
 use nalgebra::{Point2, Point3, Vector2, Vector3};
 use proptest::prelude::*;
@@ -53,7 +54,12 @@ fn endpoint_on_a_face_hits_the_larger_cell() {
     // Moving towards lower indices, the endpoint x = 2.0 belongs to cell 2, which the ray
     // crossed completely: a hit with full length.
     let mut stats = row();
-    let back = Ray2::new(Point2::new(3.5, 0.5), Vector2::new(-1.0, 0.0), Range::Hit(1.5)).unwrap();
+    let back = Ray2::new(
+        Point2::new(3.5, 0.5),
+        Vector2::new(-1.0, 0.0),
+        Range::Hit(1.5),
+    )
+    .unwrap();
     stats.insert_ray(&back, &MappingConfig::default());
     assert_eq!(stats.cell(3), CellStats::new(0, 1, 0.5));
     assert_eq!(stats.cell(2), CellStats::new(1, 0, 1.0));
@@ -69,7 +75,10 @@ fn zero_length_sub_and_no_returns() {
     assert_eq!(stats.summary().empty, 1);
 
     // No-returns are traced to r_max and add misses and length, no hit.
-    let config = MappingConfig { range: SensorRange::new(0.0, 2.0).unwrap(), ..config };
+    let config = MappingConfig {
+        range: SensorRange::new(0.0, 2.0).unwrap(),
+        ..config
+    };
     stats.insert_ray(&ray_x(0.5, Range::NoReturn), &config);
     // A return beyond r_max is a no-return too.
     stats.insert_ray(&ray_x(0.5, Range::Hit(3.0)), &config);
@@ -96,21 +105,29 @@ fn merge_rejects_other_grids() {
     let mut a = row();
     let b = DenseStats2::new(Grid2::new(Point2::new(0.0, 0.0), 1.0, [5, 1]).unwrap());
     assert!(a.merge(&b).is_err());
-    assert!(DenseStats2::from_parts(*a.grid(), vec![CellStats::EMPTY; 3], Default::default()).is_err());
+    assert!(
+        DenseStats2::from_parts(*a.grid(), vec![CellStats::EMPTY; 3], Default::default()).is_err()
+    );
 }
 
 /// Seeded rays of 20–60 m in a 3-D grid (a small version of the bench workload).
 fn random_rays(n: usize, seed: u64) -> Vec<Ray3> {
     let mut state = seed;
     let mut next = move || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
     (0..n)
         .map(|i| {
             let origin = Point3::new(20.0 * next(), 20.0 * next(), 1.0 + 2.0 * next());
             let direction = Vector3::new(next() - 0.5, next() - 0.5, 0.3 * (next() - 0.5));
-            let range = if i % 10 == 0 { Range::NoReturn } else { Range::Hit(2.0 + 20.0 * next()) };
+            let range = if i % 10 == 0 {
+                Range::NoReturn
+            } else {
+                Range::Hit(2.0 + 20.0 * next())
+            };
             Ray3::new(origin, direction, range).unwrap()
         })
         .collect()
@@ -120,13 +137,19 @@ fn random_rays(n: usize, seed: u64) -> Vec<Ray3> {
 fn parallel_dense_and_sparse_agree_for_any_thread_count() {
     let grid = Grid3::new(Point3::new(-5.0, -5.0, -2.0), 0.5, [60, 60, 14]).unwrap();
     let rays = random_rays(20_000, 7);
-    let config = MappingConfig { range: SensorRange::new(0.0, 25.0).unwrap(), ..Default::default() };
+    let config = MappingConfig {
+        range: SensorRange::new(0.0, 25.0).unwrap(),
+        ..Default::default()
+    };
     let mut sequential = DenseStats3::new(grid);
     for ray in &rays {
         sequential.insert_ray(ray, &config);
     }
     for threads in [1, 2, 3] {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         let (dense, sparse) = pool.install(|| {
             let mut dense = DenseStats3::new(grid);
             dense.insert_rays_par(&rays, &config);
@@ -134,14 +157,28 @@ fn parallel_dense_and_sparse_agree_for_any_thread_count() {
             sparse.insert_rays_par(&rays, &config);
             (dense, sparse)
         });
-        assert!(dense == sequential, "dense build with {threads} threads differs");
-        assert!(sparse.to_dense() == sequential, "sparse build with {threads} threads differs");
+        assert!(
+            dense == sequential,
+            "dense build with {threads} threads differs"
+        );
+        assert!(
+            sparse.to_dense() == sequential,
+            "sparse build with {threads} threads differs"
+        );
     }
     // Conservation: the recorded length is the traced length inside the grid.
-    let recorded: f64 = sequential.cells().iter().map(CellStats::path_length_m).sum();
+    let recorded: f64 = sequential
+        .cells()
+        .iter()
+        .map(CellStats::path_length_m)
+        .sum();
     let traced: f64 = rays
         .iter()
-        .map(|ray| grid.traverse_ray(ray, 25.0).map(|c| c.length()).sum::<f64>())
+        .map(|ray| {
+            grid.traverse_ray(ray, 25.0)
+                .map(|c| c.length())
+                .sum::<f64>()
+        })
         .sum();
     assert!((recorded - traced).abs() < 1e-6 * traced);
     let hits: u64 = sequential.cells().iter().map(|c| u64::from(c.hits())).sum();

@@ -1,4 +1,5 @@
 //! Property tests of the sensor models (Schaefer 2020, ch. 7 and 8).
+#![allow(clippy::unwrap_used, clippy::too_many_arguments)] // test code: a panic is the failure report
 
 mod common;
 
@@ -10,9 +11,9 @@ use rand_chacha::ChaCha8Rng;
 use raypath_geometry::{Grid2, Range, Ray2};
 use raypath_sensor_models::{
     BetaPosteriorConfig, BetaPrior, CellStats, DecayRateConfig, DecayRateModel2,
-    DecayRatePosteriorModel2, DenseStats2, GammaPosteriorConfig, GammaPrior,
-    LikelihoodFieldConfig, LikelihoodFieldModel2, LogOddsConfig, LogOddsModel2, MappingConfig,
-    Planar, ReflectionConfig, ReflectionModel2, SensorModel, SensorRange,
+    DecayRatePosteriorModel2, DenseStats2, GammaPosteriorConfig, GammaPrior, LikelihoodFieldConfig,
+    LikelihoodFieldModel2, LogOddsConfig, LogOddsModel2, MappingConfig, Planar, ReflectionConfig,
+    ReflectionModel2, SensorModel, SensorRange,
 };
 
 /// A 12 m × 12 m grid of 0.5 m cells at the origin.
@@ -58,7 +59,10 @@ fn data_log_likelihood(grid: &Grid2, rays: &[Ray2], rates: &[f64]) -> f64 {
         .map(|ray| {
             let r = ray.range.hit().unwrap();
             let k = grid.linear_index(grid.cell_of(&ray.at(r)).unwrap());
-            let depth: f64 = grid.traverse_ray(ray, 100.0).map(|c| rates[c.index] * c.length()).sum();
+            let depth: f64 = grid
+                .traverse_ray(ray, 100.0)
+                .map(|c| rates[c.index] * c.length())
+                .sum();
             rates[k].ln() - depth
         })
         .sum()
@@ -116,7 +120,12 @@ fn reflection_model_is_the_equal_length_limit() {
     for _ in 0..4000 {
         let k = rng.random_range(0..19usize);
         let length = (19 - k) as f64 * d + d;
-        let ray = Ray2::new(Point2::new(10.0, 0.25), Vector2::new(-1.0, 0.0), Range::Hit(length)).unwrap();
+        let ray = Ray2::new(
+            Point2::new(10.0, 0.25),
+            Vector2::new(-1.0, 0.0),
+            Range::Hit(length),
+        )
+        .unwrap();
         stats.insert_ray(&ray, &MappingConfig::default());
     }
     for (i, cell) in stats.cells().iter().enumerate() {
@@ -125,7 +134,11 @@ fn reflection_model_is_the_equal_length_limit() {
         }
         let q = cell.h() / (cell.h() + cell.m());
         let lambda = cell.h() / cell.path_length_m();
-        assert!((lambda * d - q).abs() < 1e-12, "cell {i}: λd = {} vs q = {q}", lambda * d); // Eq. (7.25)
+        assert!(
+            (lambda * d - q).abs() < 1e-12,
+            "cell {i}: λd = {} vs q = {q}",
+            lambda * d
+        ); // Eq. (7.25)
     }
     // Eq. (7.26) in the limit: scale all q down.
     for scale in [0.1, 0.01, 0.001] {
@@ -136,7 +149,10 @@ fn reflection_model_is_the_equal_length_limit() {
         let gap = (ln_ref - ln_dec).abs();
         let bound = q[k] / 2.0 + q[..k].iter().map(|qi| qi * qi).sum::<f64>();
         assert!(gap <= bound * 1.01, "scale {scale}: gap {gap} > {bound}");
-        assert!(gap < 0.6 * scale, "scale {scale}: gap {gap} does not vanish");
+        assert!(
+            gap < 0.6 * scale,
+            "scale {scale}: gap {gap} does not vanish"
+        );
     }
 }
 
@@ -146,7 +162,11 @@ fn gamma_factor(a: f64, b: f64, r: f64, hit: bool) -> f64 {
     let norm = a * b.ln() - ln_gamma(a);
     let f = |lambda: f64| {
         if lambda <= 0.0 {
-            return if a - 1.0 + delta == 0.0 { norm.exp() } else { 0.0 };
+            return if a - 1.0 + delta == 0.0 {
+                norm.exp()
+            } else {
+                0.0
+            };
         }
         (norm + (a - 1.0 + delta) * lambda.ln() - (b + r) * lambda).exp()
     };
@@ -222,7 +242,12 @@ proptest! {
 fn crossing_chord(grid: &Grid2, ray: &Ray2, cell: [usize; 2]) -> f64 {
     let bounds = grid.cell_bounds(cell);
     let (t0, t1) = bounds
-        .clip_segment(&ray.origin, ray.direction.as_ref(), f64::NEG_INFINITY, f64::INFINITY)
+        .clip_segment(
+            &ray.origin,
+            ray.direction.as_ref(),
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+        )
         .unwrap();
     t1 - t0.max(0.0)
 }
@@ -245,11 +270,19 @@ fn graded(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
 /// the grid), integrating the density cell by cell.
 fn total_probability(model: &impl SensorModel<Planar>, grid: &Grid2, ray: &Ray2) -> f64 {
     let range = model.sensor_range();
-    let at = |r: f64| Ray2 { range: Range::Hit(r), ..*ray };
+    let at = |r: f64| Ray2 {
+        range: Range::Hit(r),
+        ..*ray
+    };
     let density = |r: f64| model.ray_log_likelihood(&at(r)).exp();
-    let no_return = Ray2 { range: Range::NoReturn, ..*ray };
-    let mut cuts: Vec<f64> =
-        grid.traverse_ray(&no_return, range.max_range_m).map(|c| c.t_exit).collect();
+    let no_return = Ray2 {
+        range: Range::NoReturn,
+        ..*ray
+    };
+    let mut cuts: Vec<f64> = grid
+        .traverse_ray(&no_return, range.max_range_m)
+        .map(|c| c.t_exit)
+        .collect();
     cuts.push(range.min_range_m);
     cuts.push(0.0);
     cuts.retain(|t| *t >= range.min_range_m && *t <= range.max_range_m);
@@ -259,7 +292,12 @@ fn total_probability(model: &impl SensorModel<Planar>, grid: &Grid2, ray: &Ray2)
         .filter(|w| w[1] > w[0])
         .map(|w| graded(&density, w[0], w[1]))
         .sum();
-    let sup = model.ray_log_likelihood(&Ray2 { range: Range::NoReturn, ..*ray }).exp();
+    let sup = model
+        .ray_log_likelihood(&Ray2 {
+            range: Range::NoReturn,
+            ..*ray
+        })
+        .exp();
     let sub = if range.min_range_m > 0.0 {
         model.ray_log_likelihood(&at(0.5 * range.min_range_m)).exp()
     } else {
@@ -304,19 +342,30 @@ proptest! {
 fn constant_medium_recovers_the_decay_rate() {
     let lambda = 0.8;
     let grid = Grid2::new(Point2::new(0.0, 0.0), 0.1, [100, 1]).unwrap();
-    let config = MappingConfig { range: SensorRange::new(0.0, 9.5).unwrap(), ..Default::default() };
+    let config = MappingConfig {
+        range: SensorRange::new(0.0, 9.5).unwrap(),
+        ..Default::default()
+    };
     let mut rng = ChaCha8Rng::seed_from_u64(2017);
     let mut stats = DenseStats2::new(grid);
     for _ in 0..20_000 {
         let u: f64 = rng.random_range(f64::EPSILON..1.0);
         let r = -u.ln() / lambda;
-        let ray = Ray2::new(Point2::new(0.0, 0.05), Vector2::new(1.0, 0.0), Range::Hit(r)).unwrap();
+        let ray = Ray2::new(
+            Point2::new(0.0, 0.05),
+            Vector2::new(1.0, 0.0),
+            Range::Hit(r),
+        )
+        .unwrap();
         stats.insert_ray(&ray, &config);
     }
     let hits: f64 = stats.cells().iter().map(CellStats::h).sum();
     let length: f64 = stats.cells().iter().map(CellStats::path_length_m).sum();
     let pooled = hits / length;
-    assert!((pooled / lambda - 1.0).abs() < 0.03, "pooled estimate {pooled}");
+    assert!(
+        (pooled / lambda - 1.0).abs() < 0.03,
+        "pooled estimate {pooled}"
+    );
     let model = DecayRateModel2::new(&stats, DecayRateConfig::default()).unwrap();
     for (i, rate) in model.rates().iter().take(20).enumerate() {
         assert!((rate / lambda - 1.0).abs() < 0.25, "cell {i}: λ = {rate}");

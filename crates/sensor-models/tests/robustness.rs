@@ -1,35 +1,44 @@
 //! No NaN or infinity from any model: empty maps, zero-length rays, rays ending on cell
 //! faces, rays outside the grid, odd readings.
+#![allow(clippy::unwrap_used)] // test code: a panic is the failure report
 
 use nalgebra::{Point2, Vector2};
 use proptest::prelude::*;
 use raypath_geometry::testing::{grid2, grid3, ray2_in, ray3_in};
 use raypath_geometry::{Grid2, Range, Ray2};
 use raypath_sensor_models::{
-    BetaPosteriorConfig, DecayRateConfig, DecayRateModel, DecayRateModel2,
-    DecayRatePosteriorModel, DenseStats, DenseStats2, Dimension, GammaPosteriorConfig,
-    LikelihoodFieldConfig, LikelihoodFieldModel, LikelihoodFieldModel2, LogOddsConfig,
-    LogOddsModel, LogOddsModel2, MappingConfig, OpticalDepthConfig, ReflectionConfig,
-    ReflectionModel, ReflectionModel2, SensorModel, Tabulated,
+    BetaPosteriorConfig, DecayRateConfig, DecayRateModel, DecayRateModel2, DecayRatePosteriorModel,
+    DenseStats, DenseStats2, Dimension, GammaPosteriorConfig, LikelihoodFieldConfig,
+    LikelihoodFieldModel, LikelihoodFieldModel2, LogOddsConfig, LogOddsModel, LogOddsModel2,
+    MappingConfig, OpticalDepthConfig, ReflectionConfig, ReflectionModel, ReflectionModel2,
+    SensorModel, Tabulated,
 };
 
 /// Every model of `stats`, boxed.
 fn all_models<D: Dimension>(stats: &DenseStats<D>) -> Vec<(&'static str, Box<dyn SensorModel<D>>)> {
     vec![
-        ("decay-rate", Box::new(DecayRateModel::new(stats, DecayRateConfig::default()).unwrap())),
+        (
+            "decay-rate",
+            Box::new(DecayRateModel::new(stats, DecayRateConfig::default()).unwrap()),
+        ),
         (
             "decay-rate posterior",
             Box::new(DecayRatePosteriorModel::new(stats, GammaPosteriorConfig::default()).unwrap()),
         ),
         (
             "reflection",
-            Box::new(ReflectionModel::maximum_likelihood(stats, ReflectionConfig::default()).unwrap()),
+            Box::new(
+                ReflectionModel::maximum_likelihood(stats, ReflectionConfig::default()).unwrap(),
+            ),
         ),
         (
             "reflection posterior",
             Box::new(ReflectionModel::posterior(stats, BetaPosteriorConfig::default()).unwrap()),
         ),
-        ("log-odds", Box::new(LogOddsModel::new(stats, LogOddsConfig::default()).unwrap())),
+        (
+            "log-odds",
+            Box::new(LogOddsModel::new(stats, LogOddsConfig::default()).unwrap()),
+        ),
         (
             "likelihood field",
             Box::new(LikelihoodFieldModel::new(stats, LikelihoodFieldConfig::default()).unwrap()),
@@ -37,8 +46,16 @@ fn all_models<D: Dimension>(stats: &DenseStats<D>) -> Vec<(&'static str, Box<dyn
     ]
 }
 
-fn tabulated_models(stats: &DenseStats2) -> Vec<(&'static str, Box<dyn SensorModel<raypath_sensor_models::Planar>>)> {
-    let config = OpticalDepthConfig { directions: 24, ..Default::default() };
+fn tabulated_models(
+    stats: &DenseStats2,
+) -> Vec<(
+    &'static str,
+    Box<dyn SensorModel<raypath_sensor_models::Planar>>,
+)> {
+    let config = OpticalDepthConfig {
+        directions: 24,
+        ..Default::default()
+    };
     vec![
         (
             "decay-rate table",
@@ -54,7 +71,8 @@ fn tabulated_models(stats: &DenseStats2) -> Vec<(&'static str, Box<dyn SensorMod
             "reflection table",
             Box::new(
                 Tabulated::<ReflectionModel2>::new(
-                    ReflectionModel2::maximum_likelihood(stats, ReflectionConfig::default()).unwrap(),
+                    ReflectionModel2::maximum_likelihood(stats, ReflectionConfig::default())
+                        .unwrap(),
                     config,
                 )
                 .unwrap(),
@@ -91,7 +109,14 @@ fn special_rays(grid: &Grid2) -> Vec<Ray2> {
     let centre = Point2::new(o.x + 0.5 * c, o.y + 0.5 * c);
     let corner = o;
     let mut rays = Vec::new();
-    for (dx, dy) in [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (-1.0, -1.0), (0.3, 0.7)] {
+    for (dx, dy) in [
+        (1.0, 0.0),
+        (-1.0, 0.0),
+        (0.0, 1.0),
+        (1.0, 1.0),
+        (-1.0, -1.0),
+        (0.3, 0.7),
+    ] {
         let direction = Vector2::new(dx, dy);
         for origin in [centre, corner, Point2::new(o.x - 3.0, o.y + 0.5 * c)] {
             for range in [
@@ -112,7 +137,11 @@ fn special_rays(grid: &Grid2) -> Vec<Ray2> {
     rays
 }
 
-fn check<D: Dimension>(name: &str, model: &dyn SensorModel<D>, ray: &D::Ray) -> Result<(), TestCaseError> {
+fn check<D: Dimension>(
+    name: &str,
+    model: &dyn SensorModel<D>,
+    ray: &D::Ray,
+) -> Result<(), TestCaseError> {
     let value = model.ray_log_likelihood(ray);
     prop_assert!(value.is_finite(), "{name}: {value} for {ray:?}");
     Ok(())

@@ -108,12 +108,26 @@ impl MapFile {
                 let g = s.grid();
                 let [x, y] = g.dims();
                 let o = g.origin();
-                (2u8, g.cell_size(), [o.x, o.y, 0.0], [x, y, 1], s.cells(), s.summary())
+                (
+                    2u8,
+                    g.cell_size(),
+                    [o.x, o.y, 0.0],
+                    [x, y, 1],
+                    s.cells(),
+                    s.summary(),
+                )
             }
             StoredStats::Spatial(s) => {
                 let g = s.grid();
                 let o = g.origin();
-                (3u8, g.cell_size(), [o.x, o.y, o.z], g.dims(), s.cells(), s.summary())
+                (
+                    3u8,
+                    g.cell_size(),
+                    [o.x, o.y, o.z],
+                    g.dims(),
+                    s.cells(),
+                    s.summary(),
+                )
             }
         };
         let mut out = Vec::with_capacity(HEADER_LEN + 16 * cells.len() + 4);
@@ -201,7 +215,9 @@ impl MapFile {
         let posterior = match r.u8()? {
             0 => false,
             1 => true,
-            other => return Err(r.error_at(14, format!("posterior flag must be 0 or 1, got {other}"))),
+            other => {
+                return Err(r.error_at(14, format!("posterior flag must be 0 or 1, got {other}")));
+            }
         };
         let flags = r.u8()?;
         if flags > 1 {
@@ -227,10 +243,16 @@ impl MapFile {
             product *= u128::from(v);
         }
         if axes == 2 && origin[2].to_bits() != 0 {
-            return Err(r.error_at(40, format!("a 2-D map must have origin z = 0, got {}", origin[2])));
+            return Err(r.error_at(
+                40,
+                format!("a 2-D map must have origin z = 0, got {}", origin[2]),
+            ));
         }
         if axes == 2 && dims[2] != 1 {
-            return Err(r.error_at(64, format!("a 2-D map must have 1 cell along z, got {}", dims[2])));
+            return Err(r.error_at(
+                64,
+                format!("a 2-D map must have 1 cell along z, got {}", dims[2]),
+            ));
         }
         if u128::from(n) != product {
             return Err(r.error_at(n_at, format!("{n} cells but the axes give {product}")));
@@ -239,7 +261,10 @@ impl MapFile {
         if expected != bytes.len() as u128 {
             return Err(r.error_at(
                 n_at,
-                format!("{n} cells need {expected} bytes, the file has {}", bytes.len()),
+                format!(
+                    "{n} cells need {expected} bytes, the file has {}",
+                    bytes.len()
+                ),
             ));
         }
         let body_end = bytes.len() - 4;
@@ -374,14 +399,20 @@ impl<'a> Reader<'a> {
     }
 
     fn u32(&mut self) -> Result<u32, SensorModelError> {
-        Ok(u32::from_le_bytes(self.take(4)?.try_into().unwrap_or_default()))
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().unwrap_or_default(),
+        ))
     }
 
     fn u64(&mut self) -> Result<u64, SensorModelError> {
-        Ok(u64::from_le_bytes(self.take(8)?.try_into().unwrap_or_default()))
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().unwrap_or_default(),
+        ))
     }
 
     fn f64(&mut self) -> Result<f64, SensorModelError> {
-        Ok(f64::from_le_bytes(self.take(8)?.try_into().unwrap_or_default()))
+        Ok(f64::from_le_bytes(
+            self.take(8)?.try_into().unwrap_or_default(),
+        ))
     }
 }

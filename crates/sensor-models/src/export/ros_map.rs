@@ -138,7 +138,11 @@ pub fn write_ros_map(
 
 /// Writes a grayscale PNG picture (same pixels as the PGM: dark = high probability,
 /// gray 205 = unknown, top = largest y).
-pub fn write_png(path: &Path, grid: &Grid2, values: &[Option<f64>]) -> Result<(), SensorModelError> {
+pub fn write_png(
+    path: &Path,
+    grid: &Grid2,
+    values: &[Option<f64>],
+) -> Result<(), SensorModelError> {
     let pixels = map_image(grid, values)?;
     let [width, height] = grid.dims();
     let image_error = |reason: String| SensorModelError::Image {

@@ -81,7 +81,10 @@ impl<D: Dimension> BernoulliField<D> {
 
     /// All cells' `μ_i`.
     pub fn probabilities(&self) -> Vec<f64> {
-        self.log_probs.iter().map(|[ln_mu, _]| ln_mu.exp()).collect()
+        self.log_probs
+            .iter()
+            .map(|[ln_mu, _]| ln_mu.exp())
+            .collect()
     }
 
     /// `μ₀`, the reflection probability of unobserved space outside the grid.

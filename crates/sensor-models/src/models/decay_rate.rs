@@ -141,7 +141,12 @@ impl<D: Dimension> DecayRateModel<D> {
         D::traverse(&self.grid, ray, length_m).for_each(|c| {
             let d = c.length();
             inside += d;
-            depth += self.rates.get(c.index()).copied().unwrap_or(self.unknown_rate) * d;
+            depth += self
+                .rates
+                .get(c.index())
+                .copied()
+                .unwrap_or(self.unknown_rate)
+                * d;
         });
         depth + self.unknown_rate * (length_m - inside).max(0.0)
     }
@@ -164,9 +169,7 @@ impl<D: Dimension> SensorModel<D> for DecayRateModel<D> {
                 self.rate_at(ray_in_map, r).ln() - self.optical_depth(ray_in_map, r)
             }
             Reading::Sup => -self.optical_depth(ray_in_map, range.max_range_m), // Eq. (7.16)
-            Reading::Sub => {
-                ln_one_minus_exp_neg(self.optical_depth(ray_in_map, range.min_range_m))
-            }
+            Reading::Sub => ln_one_minus_exp_neg(self.optical_depth(ray_in_map, range.min_range_m)),
         };
         finite_or_neg_inf(value)
     }

@@ -115,7 +115,11 @@ impl<D: Dimension> DecayRatePosteriorModel<D> {
             }
         });
         log_miss -= self.outside_rate * (length_m - inside).max(0.0);
-        (log_miss, last_length, D::cell_index_at(&self.grid, ray, length_m))
+        (
+            log_miss,
+            last_length,
+            D::cell_index_at(&self.grid, ray, length_m),
+        )
     }
 }
 

@@ -187,7 +187,12 @@ impl<D: Dimension> LikelihoodFieldModel<D> {
         D::traverse(&self.grid, ray, hi).for_each(|c| {
             let overlap = (c.t_exit().min(hi) - c.t_enter().max(lo)).max(0.0);
             inside += overlap;
-            integral += self.field.get(c.index()).copied().unwrap_or(self.outside_value) * overlap;
+            integral += self
+                .field
+                .get(c.index())
+                .copied()
+                .unwrap_or(self.outside_value)
+                * overlap;
         });
         integral + self.outside_value * ((hi - lo) - inside).max(0.0)
     }
@@ -203,7 +208,12 @@ impl<D: Dimension> LikelihoodFieldModel<D> {
 
     /// The log-likelihood given the normalizer (`None`: unnormalized AMCL value).
     #[inline]
-    pub(crate) fn log_likelihood_with(&self, reading: Reading, q: f64, normalizer: Option<f64>) -> f64 {
+    pub(crate) fn log_likelihood_with(
+        &self,
+        reading: Reading,
+        q: f64,
+        normalizer: Option<f64>,
+    ) -> f64 {
         let config = &self.config;
         let value = match reading {
             Reading::Hit(_) => match normalizer {

@@ -23,8 +23,8 @@ pub use reflection::{
     BetaPosteriorConfig, ReflectionConfig, ReflectionModel, ReflectionModel2, ReflectionModel3,
 };
 
-use crate::dimension::Dimension;
 use crate::SensorRange;
+use crate::dimension::Dimension;
 
 /// A lidar sensor model: the log-likelihood of one ray's measurement given the map.
 ///
@@ -74,5 +74,9 @@ pub(crate) fn ln_one_minus_exp_neg(x: f64) -> f64 {
 /// Replaces NaN by `−∞` (the models' contract: never NaN).
 #[inline]
 pub(crate) fn finite_or_neg_inf(value: f64) -> f64 {
-    if value.is_nan() { f64::NEG_INFINITY } else { value }
+    if value.is_nan() {
+        f64::NEG_INFINITY
+    } else {
+        value
+    }
 }

@@ -2,8 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::stats::CellStats;
 use crate::SensorModelError;
+use crate::stats::CellStats;
 
 /// Mean and variance of a map's ML cell values, over the cells that enter the estimate
 /// (spec decision A9: observed cells with a finite ML value).
@@ -203,7 +203,10 @@ mod tests {
             mean: 0.5,
             variance: 0.0,
         };
-        assert_eq!(GammaPrior::from_moments(&flat), GammaPrior::new(1.0, 2.0).unwrap());
+        assert_eq!(
+            GammaPrior::from_moments(&flat),
+            GammaPrior::new(1.0, 2.0).unwrap()
+        );
     }
 
     #[test]

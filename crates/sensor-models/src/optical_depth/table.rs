@@ -82,7 +82,11 @@ impl OpticalDepthTable {
     ) -> Result<Self, SensorModelError> {
         if field.len() != grid.num_cells() {
             return Err(SensorModelError::GridMismatch {
-                reason: format!("{} field values for {} cells", field.len(), grid.num_cells()),
+                reason: format!(
+                    "{} field values for {} cells",
+                    field.len(),
+                    grid.num_cells()
+                ),
             });
         }
         if config.directions == 0 || config.directions > 1 << 16 {
@@ -113,7 +117,12 @@ impl OpticalDepthTable {
                 let theta = d as f64 * PI / config.directions as f64;
                 let (sin, cos) = theta.sin_cos();
                 // Projections of the box corners (relative to the origin) onto u and v.
-                let corners = [(0.0, 0.0), (extent.x, 0.0), (0.0, extent.y), (extent.x, extent.y)];
+                let corners = [
+                    (0.0, 0.0),
+                    (extent.x, 0.0),
+                    (0.0, extent.y),
+                    (extent.x, extent.y),
+                ];
                 let (mut u_lo, mut u_hi, mut v_lo, mut v_hi) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
                 for (x, y) in corners {
                     let u = x * cos + y * sin;

@@ -113,7 +113,10 @@ macro_rules! tabulated_bernoulli {
     ($model:ty, $doc:literal) => {
         impl Tabulated<$model> {
             #[doc = $doc]
-            pub fn new(model: $model, config: OpticalDepthConfig) -> Result<Self, SensorModelError> {
+            pub fn new(
+                model: $model,
+                config: OpticalDepthConfig,
+            ) -> Result<Self, SensorModelError> {
                 let field = model.field();
                 let c = Planar::cell_size(field.grid());
                 let rho: Vec<f64> = field.log_probs().iter().map(|p| -p[1]).collect();
@@ -146,8 +149,14 @@ macro_rules! tabulated_bernoulli {
     };
 }
 
-tabulated_bernoulli!(ReflectionModel2, "Tabulates `ρ_i = −ln(1 − μ_i)` of a reflection model (ML or posterior).");
-tabulated_bernoulli!(LogOddsModel2, "Tabulates `ρ_i = −ln(1 − p_i)` of an occupancy map.");
+tabulated_bernoulli!(
+    ReflectionModel2,
+    "Tabulates `ρ_i = −ln(1 − μ_i)` of a reflection model (ML or posterior)."
+);
+tabulated_bernoulli!(
+    LogOddsModel2,
+    "Tabulates `ρ_i = −ln(1 − p_i)` of an occupancy map."
+);
 
 /// The reflection-model ray likelihood with table sums.
 #[inline]
@@ -162,9 +171,9 @@ fn bernoulli_log_likelihood<M>(
     let value = match range.classify(ray.range) {
         Reading::Hit(r) => {
             let depth = tabulated.path_integral(ray, 0.0, r);
-            match Planar::cell_index_at(grid, ray, r).and_then(|k| {
-                tabulated.endpoint.get(k).map(|e| (k, e))
-            }) {
+            match Planar::cell_index_at(grid, ray, r)
+                .and_then(|k| tabulated.endpoint.get(k).map(|e| (k, e)))
+            {
                 Some((k, [ln_mu, rho])) => {
                     let (t0, t1) = Planar::chord(grid, ray, k);
                     // Remove the endpoint cell's own share of the table sum.
@@ -212,7 +221,11 @@ impl SensorModel<Planar> for Tabulated<LikelihoodFieldModel2> {
             Reading::Hit(r) => {
                 let q = self.model.field_at(ray_in_map, r);
                 let normalizer = config.normalize.then(|| {
-                    self.path_integral(ray_in_map, config.range.min_range_m, config.range.max_range_m)
+                    self.path_integral(
+                        ray_in_map,
+                        config.range.min_range_m,
+                        config.range.max_range_m,
+                    )
                 });
                 self.model.log_likelihood_with(reading, q, normalizer)
             }
@@ -224,4 +237,3 @@ impl SensorModel<Planar> for Tabulated<LikelihoodFieldModel2> {
         self.model.config().range
     }
 }
-

@@ -105,8 +105,9 @@ impl CellStats {
 /// Metres to fixed-point units, rounding to nearest; negative and NaN give 0.
 #[inline(always)]
 fn to_units(length_m: f64) -> u64 {
-    // `as` saturates and maps NaN to 0; a negative value gives 0 as well.
-    (length_m * LENGTH_UNITS_PER_M + 0.5) as u64
+    // `max` maps NaN and negative values to 0; `as i64` (one instruction, unlike `as u64`)
+    // saturates, so the result is at most 2^63 − 1 and never wraps.
+    (length_m.max(0.0) * LENGTH_UNITS_PER_M + 0.5) as i64 as u64
 }
 
 #[cfg(test)]

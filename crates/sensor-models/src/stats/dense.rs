@@ -4,11 +4,11 @@ use rayon::prelude::*;
 
 use raypath_geometry::{Grid2, Grid3, PointCloud, Pose2, Pose3, Ray3, Scan2};
 
+use crate::SensorModelError;
 use crate::dimension::{Crossing, Dimension, Planar, Spatial};
 use crate::stats::insert::{StatsSink, insert_ray};
 use crate::stats::parallel::insert_parallel;
 use crate::stats::{CellStats, MappingConfig, MappingSummary};
-use crate::SensorModelError;
 
 /// Per-cell ray statistics on every cell of a grid, stored densely (linear index x fastest,
 /// as [`Grid3::linear_index`]). 16 bytes per cell: a 400 × 400 × 80 grid of 0.5 m voxels
@@ -189,7 +189,10 @@ impl DenseStats<Spatial> {
         let origin = self.grid.origin();
         let mut cells = vec![CellStats::EMPTY; nx * ny];
         for z in 0..nz {
-            let layer = self.cells.get(z * nx * ny..(z + 1) * nx * ny).unwrap_or_default();
+            let layer = self
+                .cells
+                .get(z * nx * ny..(z + 1) * nx * ny)
+                .unwrap_or_default();
             for (into, from) in cells.iter_mut().zip(layer) {
                 into.merge(from);
             }

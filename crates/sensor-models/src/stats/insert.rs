@@ -1,8 +1,8 @@
 //! Inserting one ray into any statistics store (the inner loop of MAP-DECAY).
 
+use crate::Reading;
 use crate::dimension::{Crossing, Dimension};
 use crate::stats::{CellStats, MappingConfig, MappingSummary};
-use crate::Reading;
 
 /// A store of per-cell statistics that a ray can be written into.
 pub(crate) trait StatsSink<D: Dimension> {

@@ -5,8 +5,8 @@ use std::sync::Mutex;
 use rayon::prelude::*;
 
 use crate::dimension::Dimension;
-use crate::stats::insert::{StatsSink, insert_ray};
 use crate::stats::MappingConfig;
+use crate::stats::insert::{StatsSink, insert_ray};
 
 /// Inserts the rays of `items` into `target` in parallel.
 ///
@@ -40,7 +40,9 @@ pub(crate) fn insert_parallel<D, S, T>(
         let taken = pool.lock().unwrap_or_else(|e| e.into_inner()).pop();
         let mut partial = taken.unwrap_or_else(&empty);
         for item in chunk {
-            rays_of(item, &mut |ray| insert_ray::<D, S>(&mut partial, ray, config));
+            rays_of(item, &mut |ray| {
+                insert_ray::<D, S>(&mut partial, ray, config)
+            });
         }
         pool.lock().unwrap_or_else(|e| e.into_inner()).push(partial);
     });

@@ -4,13 +4,13 @@ use std::collections::HashMap;
 
 use raypath_geometry::{PointCloud, Pose3};
 
+use crate::SensorModelError;
 use crate::dimension::{Crossing, Dimension, Planar, Spatial};
 use crate::stats::dense::for_each_cloud_ray;
 use crate::stats::hasher::BuildKeyHasher;
 use crate::stats::insert::{StatsSink, insert_ray};
 use crate::stats::parallel::insert_parallel;
 use crate::stats::{CellStats, DenseStats, MappingConfig, MappingSummary};
-use crate::SensorModelError;
 
 /// Edge of a block in cells.
 pub const BLOCK_EDGE: usize = 8;
