@@ -220,7 +220,8 @@ proptest! {
             prop_assert!((model_dec - ln_dec).abs() < 1e-6, "decay: {model_dec} vs {ln_dec}");
             // The reflection model's density divides by the endpoint cell's chord (Eq. 7.32).
             let k = crossings[last];
-            let chord = crossing_chord(&grid, &ray, k.cell);
+            // Returns at or beyond r_max are `sup`, so the chord is clipped to r_max.
+            let chord = crossing_chord(&grid, &ray, k.cell, range.max_range_m);
             let model_ref = refl.ray_log_likelihood(&ray) + chord.ln();
             prop_assert!((model_ref - ln_ref).abs() < 1e-6, "reflection: {model_ref} vs {ln_ref}");
             // No-returns: the miss factors up to r_max.
@@ -238,8 +239,8 @@ proptest! {
     }
 }
 
-/// The chord of the ray's line through a cell, clipped to `t ≥ 0`.
-fn crossing_chord(grid: &Grid2, ray: &Ray2, cell: [usize; 2]) -> f64 {
+/// The chord of the ray's line through a cell, clipped to `0 ≤ t ≤ max_range_m`.
+fn crossing_chord(grid: &Grid2, ray: &Ray2, cell: [usize; 2], max_range_m: f64) -> f64 {
     let bounds = grid.cell_bounds(cell);
     let (t0, t1) = bounds
         .clip_segment(
@@ -249,7 +250,7 @@ fn crossing_chord(grid: &Grid2, ray: &Ray2, cell: [usize; 2]) -> f64 {
             f64::INFINITY,
         )
         .unwrap();
-    t1 - t0.max(0.0)
+    t1.min(max_range_m) - t0.max(0.0)
 }
 
 /// `∫ f` over `[a, b]` on pieces that shrink geometrically towards `a` (where the
