@@ -36,6 +36,15 @@ enum Command {
     /// Generate simulated data in real formats (CARMEN, PCD, KITTI, NCLT): polygons, indoor
     /// worlds, the 1-D corridor, SynPEB-style rooms, urban drives, semi-synthetic KITTI.
     Simulate(commands::simulate::Args),
+    /// Build a map from a CARMEN log (corrected poses) or a 3-D sequence: per-cell ray
+    /// statistics and a decay-rate, reflection or log-odds model (PGM+YAML and binary map).
+    Map(commands::map::Args),
+    /// Score every sensor model on a corrected CARMEN log: negative log-likelihood at the true
+    /// poses and inverse KL over poses in a disc (Schaefer Table 7.3, Table 8.2/8.3 ratios).
+    ScoreModel(commands::score_model::Args),
+    /// Monte-Carlo localization of a log in a map written by `raypath map`; with ground truth,
+    /// the error summary.
+    Localize(commands::localize::Args),
 }
 
 fn main() -> ExitCode {
@@ -43,6 +52,9 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Info(args) => commands::info::run(args),
         Command::Simulate(args) => commands::simulate::run(args),
+        Command::Map(args) => commands::map::run(args),
+        Command::ScoreModel(args) => commands::score_model::run(args),
+        Command::Localize(args) => commands::localize::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,8 +5,11 @@
 //! data directory) and `target/eval/<name>.json`.
 
 mod carmen_angles;
+mod corridor;
 mod geometry;
 mod io;
+mod mcl;
+mod sensor_models;
 mod sim;
 
 use std::path::{Path, PathBuf};
@@ -90,6 +93,16 @@ const EVALUATIONS: &[(&str, &str, EvalFn)] = &[
         "carmen-angles",
         "CARMEN beam-angle convention checked by map sharpness on the corrected logs",
         carmen_angles::run,
+    ),
+    (
+        "sensor-models",
+        "sensor models scored at the true pose and by inverse KL (Schaefer Tables 7.3, 8.2, 8.3)",
+        sensor_models::run,
+    ),
+    (
+        "mcl",
+        "Monte-Carlo localization error per sensor model (Table 7.2), ch. 8 corridor, filter speed",
+        mcl::run,
     ),
 ];
 

@@ -1,6 +1,9 @@
 //! One module per subcommand, plus the shared failure type.
 
 pub mod info;
+pub mod localize;
+pub mod map;
+pub mod score_model;
 pub mod simulate;
 
 use std::process::ExitCode;
