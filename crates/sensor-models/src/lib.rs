@@ -9,6 +9,7 @@ mod models;
 mod optical_depth;
 mod reading;
 mod scan;
+pub mod scoring;
 mod stats;
 
 pub use dimension::{Crossing, Dimension, Planar, Spatial};
