@@ -123,6 +123,7 @@ pub mod eval;
 mod filter;
 pub mod init;
 pub mod kld;
+pub mod lidar;
 mod models;
 pub mod motion;
 pub mod resample;
