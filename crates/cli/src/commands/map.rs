@@ -1,22 +1,447 @@
-//! `raypath map`: build a sensor-model map from a log or sequence
+//! `raypath map`: build a sensor-model map from a log or sequence.
 //!
-//! (Being written for issue 4.)
+//! ```text
+//! raypath map <log-or-sequence> --model decay-rate|reflection|log-odds [--posterior]
+//!             --resolution R --out PREFIX [--json]
+//!             [--max-range M] [--min-range M] [--ray-step N] [--skip-no-returns] [--sparse]
+//! ```
+//!
+//! Inputs:
+//! * a CARMEN log (plain, gzip or bzip2) with corrected poses: every laser message's
+//!   `world_from_laser` pose is trusted as ground truth → a 2-D map;
+//! * a KITTI-layout sequence directory (`velodyne/*.bin` + `poses.txt`, or the benchmark
+//!   layout `sequences/NN` + `poses/NN.txt`): camera-0 poses are turned into velodyne poses
+//!   with `Tr` of `calib.txt` (without `calib.txt` the poses are taken as velodyne poses) →
+//!   a 3-D map;
+//! * an NCLT session directory (`velodyne_sync/*.bin` + `groundtruth_<date>.csv`): every
+//!   revolution gets the ground-truth pose nearest in time (REP-103 body frame; the points
+//!   are turned from x-forward/y-right/z-down to x-forward/y-left/z-up; the small
+//!   body-to-velodyne offset is ignored) → a 3-D map.
+//!
+//! The grid covers the sensor positions and all returns within the maximum range, plus one
+//! cell. Outputs: `PREFIX.pgm` + `PREFIX.yaml` (ROS `map_server`; a 3-D map is shown as its
+//! vertical column sums), `PREFIX.png` (same picture) and `PREFIX.rpmap` (the binary map of
+//! `raypath_sensor_models::export`, read by `raypath localize`; it records the model and the
+//! posterior flag). Pictures show the ML map value (reflection probability, decay-rate hit
+//! probability over one cell, or log-odds occupancy).
+
+mod input;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use raypath_sensor_models::export::{
+    MapFile, MapKind, MapPicture, RosMapOptions, StoredStats, picture_values, write_png,
+    write_ros_map,
+};
+use raypath_sensor_models::{
+    DenseStats2, DenseStats3, MappingConfig, MappingSummary, SparseStats3,
+};
 
 use super::Failure;
+use input::{Input, Sweep3};
+
+/// The sensor model a map is built for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Model {
+    /// The decay-rate model (Schaefer 2020, ch. 7): λ = H / R.
+    DecayRate,
+    /// The reflection model: μ = H / (H + M).
+    Reflection,
+    /// Log-odds occupancy (OctoMap defaults).
+    LogOdds,
+}
+
+impl Model {
+    fn name(self) -> &'static str {
+        match self {
+            Model::DecayRate => "decay-rate",
+            Model::Reflection => "reflection",
+            Model::LogOdds => "log-odds",
+        }
+    }
+
+    fn kind(self) -> MapKind {
+        match self {
+            Model::DecayRate => MapKind::DecayRate,
+            Model::Reflection => MapKind::Reflection,
+            Model::LogOdds => MapKind::LogOdds,
+        }
+    }
+
+    fn picture(self) -> MapPicture {
+        match self {
+            Model::DecayRate => MapPicture::DecayRate,
+            Model::Reflection => MapPicture::Reflection,
+            Model::LogOdds => MapPicture::Occupancy,
+        }
+    }
+}
 
 /// Arguments of `raypath map`.
 #[derive(clap::Args)]
 pub struct Args {
+    /// A CARMEN log with corrected poses (2-D), a KITTI sequence directory or an NCLT
+    /// session directory (3-D).
+    pub input: PathBuf,
+    /// The sensor model the map is for.
+    #[arg(long, value_enum)]
+    pub model: Model,
+    /// The full-posterior variant (Beta / Gamma map posteriors, Schaefer ch. 8); not for
+    /// log-odds.
+    #[arg(long)]
+    pub posterior: bool,
+    /// Cell edge in metres.
+    #[arg(long)]
+    pub resolution: f64,
+    /// Output prefix: writes PREFIX.pgm, PREFIX.yaml, PREFIX.png and PREFIX.rpmap.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Maximum range r_max in metres: returns at or beyond it (and no-returns) are traced
+    /// to it as pure misses (default 80 m).
+    #[arg(long, default_value_t = 80.0)]
+    pub max_range: f64,
+    /// Minimum range r_min in metres: returns below it are ignored.
+    #[arg(long, default_value_t = 0.0)]
+    pub min_range: f64,
+    /// Use every N-th ray (beam or point) only.
+    #[arg(long, default_value_t = 1)]
+    pub ray_step: usize,
+    /// Do not trace no-returns (by default they add misses and path length up to r_max).
+    #[arg(long)]
+    pub skip_no_returns: bool,
+    /// 3-D: build in the blocked sparse grid (less memory while mapping; the stored map is
+    /// dense).
+    #[arg(long)]
+    pub sparse: bool,
     /// Print one JSON document on standard output.
     #[arg(long)]
     pub json: bool,
 }
 
+/// Largest dense map `raypath map` allocates (cells); 16 bytes per cell.
+const MAX_CELLS: usize = 200_000_000;
+
 /// Runs `raypath map`.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    Err(Failure {
-        message: "raypath map is not implemented yet".to_owned(),
+    let started = Instant::now();
+    let config = check_args(args)?;
+    let input = Input::read(&args.input, args.ray_step, &config)
+        .map_err(|e| Failure::input(e, args.json))?;
+    let mapping_started = Instant::now();
+    let (stats, dims) = match &input {
+        Input::Planar { scans, bounds } => {
+            let grid = raypath_geometry::Grid2::covering(bounds, args.resolution)
+                .map_err(|e| grid_failure(args, e))?;
+            check_size(args, grid.num_cells())?;
+            let mut stats = DenseStats2::planar(grid);
+            let step = args.ray_step;
+            stats.insert_par(scans, &config, |(pose, scan), sink| {
+                for ray in scan.rays(*pose).step_by(step) {
+                    sink(&ray);
+                }
+            });
+            (StoredStats::Planar(stats), 2)
+        }
+        Input::Spatial { sweeps, bounds } => {
+            let grid = raypath_geometry::Grid3::covering(bounds, args.resolution)
+                .map_err(|e| grid_failure(args, e))?;
+            check_size(args, grid.num_cells())?;
+            let rays_of = |sweep: &Sweep3, sink: &mut dyn FnMut(&raypath_geometry::Ray3)| {
+                sweep.for_each_ray(sink);
+            };
+            let stats = if args.sparse {
+                let mut sparse = SparseStats3::new(grid);
+                sparse.insert_par(sweeps, &config, rays_of);
+                sparse.to_dense()
+            } else {
+                let mut dense = DenseStats3::spatial(grid);
+                dense.insert_par(sweeps, &config, rays_of);
+                dense
+            };
+            (StoredStats::Spatial(stats), 3)
+        }
+    };
+    let mapping_secs = mapping_started.elapsed().as_secs_f64();
+    let file = MapFile {
+        kind: args.model.kind(),
+        posterior: args.posterior,
+        mapping: config,
+        stats,
+    };
+    let written = write_outputs(args, &file)?;
+    let report = Report::of(args, &file, dims, mapping_secs, started, written);
+    if args.json {
+        println!("{}", report.json());
+    } else {
+        report.print();
+    }
+    Ok(())
+}
+
+fn check_args(args: &Args) -> Result<MappingConfig, Failure> {
+    let bad = |message: String| Failure {
+        message,
+        bad_input: true,
+        json: args.json,
+    };
+    if args.posterior && args.model == Model::LogOdds {
+        return Err(bad(
+            "--posterior is not defined for --model log-odds: only the decay-rate (Gamma) and \
+             reflection (Beta) models have full map posteriors"
+                .into(),
+        ));
+    }
+    if !(args.resolution.is_finite() && args.resolution > 0.0) {
+        return Err(bad(format!(
+            "--resolution must be a positive number of metres, got {}",
+            args.resolution
+        )));
+    }
+    if args.ray_step == 0 {
+        return Err(bad("--ray-step must be at least 1".into()));
+    }
+    let mut config = MappingConfig::with_range(args.min_range, args.max_range)
+        .map_err(|e| bad(format!("--min-range/--max-range: {e}")))?;
+    config.include_no_returns = !args.skip_no_returns;
+    Ok(config)
+}
+
+fn grid_failure(args: &Args, error: impl std::fmt::Display) -> Failure {
+    Failure::input(
+        format!(
+            "{}: cannot build a grid of {} m cells over the data: {error}",
+            args.input.display(),
+            args.resolution
+        ),
+        args.json,
+    )
+}
+
+fn check_size(args: &Args, cells: usize) -> Result<(), Failure> {
+    if cells > MAX_CELLS {
+        return Err(Failure::input(
+            format!(
+                "{}: the map would have {cells} cells of {} m (at most {MAX_CELLS}); use a \
+                 coarser --resolution or a smaller --max-range",
+                args.input.display(),
+                args.resolution
+            ),
+            args.json,
+        ));
+    }
+    Ok(())
+}
+
+/// The files written.
+struct Written {
+    pgm: PathBuf,
+    yaml: PathBuf,
+    png: PathBuf,
+    rpmap: PathBuf,
+}
+
+fn with_suffix(prefix: &Path, suffix: &str) -> PathBuf {
+    let mut name = prefix.as_os_str().to_owned();
+    name.push(suffix);
+    PathBuf::from(name)
+}
+
+fn write_outputs(args: &Args, file: &MapFile) -> Result<Written, Failure> {
+    let failure = |e: raypath_sensor_models::SensorModelError| Failure {
+        message: e.to_string(),
         bad_input: false,
         json: args.json,
+    };
+    if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| Failure {
+            message: format!("{}: cannot create the directory: {e}", dir.display()),
+            bad_input: false,
+            json: args.json,
+        })?;
+    }
+    let projected;
+    let planar = match &file.stats {
+        StoredStats::Planar(stats) => stats,
+        StoredStats::Spatial(stats) => {
+            projected = stats.project_z();
+            &projected
+        }
+    };
+    let values = picture_values(planar, args.model.picture());
+    // `write_ros_map` replaces the extension; give it a name whose "extension" is ours.
+    let (pgm, yaml) = write_ros_map(
+        &with_suffix(&args.out, ".pgm"),
+        planar.grid(),
+        &values,
+        &RosMapOptions::default(),
+    )
+    .map_err(failure)?;
+    let png = with_suffix(&args.out, ".png");
+    write_png(&png, planar.grid(), &values).map_err(failure)?;
+    let rpmap = with_suffix(&args.out, ".rpmap");
+    file.write_file(&rpmap).map_err(failure)?;
+    Ok(Written {
+        pgm,
+        yaml,
+        png,
+        rpmap,
     })
+}
+
+/// What `raypath map` prints.
+struct Report {
+    model: &'static str,
+    posterior: bool,
+    dims: usize,
+    grid_dims: Vec<usize>,
+    resolution: f64,
+    cells: usize,
+    observed_cells: usize,
+    summary: MappingSummary,
+    extent_min: Vec<f64>,
+    extent_max: Vec<f64>,
+    mapping_secs: f64,
+    total_secs: f64,
+    written: Written,
+}
+
+impl Report {
+    fn of(
+        args: &Args,
+        file: &MapFile,
+        dims: usize,
+        mapping_secs: f64,
+        started: Instant,
+        written: Written,
+    ) -> Self {
+        let (grid_dims, cells, observed, summary, min, max) = match &file.stats {
+            StoredStats::Planar(s) => {
+                let b = s.grid().bounds();
+                (
+                    s.grid().dims().to_vec(),
+                    s.cells().len(),
+                    s.cells().iter().filter(|c| !c.is_empty()).count(),
+                    *s.summary(),
+                    vec![b.min.x, b.min.y],
+                    vec![b.max.x, b.max.y],
+                )
+            }
+            StoredStats::Spatial(s) => {
+                let b = s.grid().bounds();
+                (
+                    s.grid().dims().to_vec(),
+                    s.cells().len(),
+                    s.cells().iter().filter(|c| !c.is_empty()).count(),
+                    *s.summary(),
+                    vec![b.min.x, b.min.y, b.min.z],
+                    vec![b.max.x, b.max.y, b.max.z],
+                )
+            }
+        };
+        Self {
+            model: args.model.name(),
+            posterior: args.posterior,
+            dims,
+            grid_dims,
+            resolution: args.resolution,
+            cells,
+            observed_cells: observed,
+            summary,
+            extent_min: min,
+            extent_max: max,
+            mapping_secs,
+            total_secs: started.elapsed().as_secs_f64(),
+            written,
+        }
+    }
+
+    fn rays_per_second(&self) -> f64 {
+        if self.mapping_secs > 0.0 {
+            self.summary.rays as f64 / self.mapping_secs
+        } else {
+            0.0
+        }
+    }
+
+    fn json(&self) -> serde_json::Value {
+        let path = |p: &Path| p.display().to_string();
+        serde_json::json!({
+            "model": self.model,
+            "posterior": self.posterior,
+            "dimensions": self.dims,
+            "resolution": self.resolution,
+            "grid": self.grid_dims,
+            "cells": self.cells,
+            "observed_cells": self.observed_cells,
+            "rays": self.summary.rays,
+            "hits": self.summary.hits,
+            "no_returns_traced": self.summary.no_returns_traced,
+            "no_returns_skipped": self.summary.no_returns_skipped,
+            "endpoints_outside": self.summary.endpoints_outside,
+            "sub_ignored": self.summary.sub_ignored,
+            "crossings": self.summary.crossings,
+            "extent": { "min": self.extent_min, "max": self.extent_max },
+            "mapping_seconds": self.mapping_secs,
+            "seconds": self.total_secs,
+            "rays_per_second": self.rays_per_second(),
+            "files": {
+                "pgm": path(&self.written.pgm),
+                "yaml": path(&self.written.yaml),
+                "png": path(&self.written.png),
+                "rpmap": path(&self.written.rpmap),
+            },
+        })
+    }
+
+    fn print(&self) {
+        let grid: Vec<String> = self.grid_dims.iter().map(usize::to_string).collect();
+        let coords = |v: &[f64]| {
+            v.iter()
+                .map(|x| format!("{x:.2}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        println!(
+            "{} map{} ({}-D), {} m cells: {} = {} cells, {} observed",
+            self.model,
+            if self.posterior {
+                " (full posterior)"
+            } else {
+                ""
+            },
+            self.dims,
+            self.resolution,
+            grid.join(" × "),
+            self.cells,
+            self.observed_cells
+        );
+        println!(
+            "extent: [{}] to [{}] m",
+            coords(&self.extent_min),
+            coords(&self.extent_max)
+        );
+        println!(
+            "rays: {} ({} hits, {} no-returns traced, {} returns ending outside the grid, {} below r_min)",
+            self.summary.rays,
+            self.summary.hits,
+            self.summary.no_returns_traced,
+            self.summary.endpoints_outside,
+            self.summary.sub_ignored
+        );
+        println!(
+            "time: {:.2} s mapping ({:.0} rays/s), {:.2} s in all",
+            self.mapping_secs,
+            self.rays_per_second(),
+            self.total_secs
+        );
+        for p in [
+            &self.written.pgm,
+            &self.written.yaml,
+            &self.written.png,
+            &self.written.rpmap,
+        ] {
+            println!("wrote {}", p.display());
+        }
+    }
 }
