@@ -59,7 +59,8 @@ impl Default for TrackConfig {
 /// What [`track_planar`] produced.
 #[derive(Clone, Debug)]
 pub struct PlanarTrack {
-    /// The estimate after every update (`world_from_robot`, map frame), with its step index.
+    /// The estimate after every update (`world_from_robot`, map frame), with its step index;
+    /// one per time stamp (the latest when a log repeats a stamp).
     pub estimates: Vec<(usize, Stamped<Pose2>)>,
     /// Number of filter updates.
     pub updates: usize,
@@ -123,6 +124,15 @@ pub fn track_planar<M: SensorModel<Planar>>(
             }
             Err(LocalizerError::AllParticlesImpossible { .. }) => out.failed_updates += 1,
             Err(e) => return Err(e),
+        }
+        // Logs may repeat a time stamp; keep the latest estimate per stamp so that the
+        // estimates form a track with strictly increasing times.
+        if out
+            .estimates
+            .last()
+            .is_some_and(|(_, last)| last.stamp_secs >= step.stamp_secs)
+        {
+            out.estimates.pop();
         }
         out.estimates.push((
             index,

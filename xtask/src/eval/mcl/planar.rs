@@ -113,6 +113,16 @@ pub fn load(
     }
     matched.sort_by_key(|m| m.0);
     matched.dedup_by_key(|m| m.0);
+    // Keep strictly increasing times (raw logs repeat a logger stamp now and then).
+    let mut last_stamp = f64::NEG_INFINITY;
+    matched.retain(|(j, _)| {
+        let t = raw_stamps.get(*j).copied().unwrap_or(f64::NAN);
+        let keep = t > last_stamp;
+        if keep {
+            last_stamp = t;
+        }
+        keep
+    });
     if matched.len() < 2 {
         bail!("{name}: only {} corrected scans matched raw scans", matched.len());
     }
