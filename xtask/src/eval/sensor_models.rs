@@ -61,7 +61,7 @@ const QUICK: Plan = Plan {
 const FULL: Plan = Plan {
     real_logs: None,
     sim_logs: None,
-    max_test_scans_2d: Some(400),
+    max_test_scans_2d: Some(300),
     beam_step_2d: 1,
     frames_3d: 200,
     map_ray_step_3d: 1,
@@ -122,7 +122,10 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     let mut logs: Vec<(Kind, std::path::PathBuf)> =
         data::files_ending(&real_dir, &["-corrected.log.gz"])
             .into_iter()
-            .filter(|p| plan.real_logs.is_none_or(|names| names.contains(&data::log_name(p).as_str())))
+            .filter(|p| {
+                plan.real_logs
+                    .is_none_or(|names| names.contains(&data::log_name(p).as_str()))
+            })
             .map(|p| (Kind::Real, p))
             .collect();
     if logs.is_empty() {
@@ -133,10 +136,16 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     }
     match generate::ensure("indoor", ctx.quick) {
         Ok(dir) => logs.extend(
-            data::files_ending(&dir, &["-corrected.log", "-corrected.log.gz", "-corrected.log.bz2"])
-                .into_iter()
-                .filter(|p| plan.sim_logs.is_none_or(|names| names.contains(&data::log_name(p).as_str())))
-                .map(|p| (Kind::Sim2, p)),
+            data::files_ending(
+                &dir,
+                &["-corrected.log", "-corrected.log.gz", "-corrected.log.bz2"],
+            )
+            .into_iter()
+            .filter(|p| {
+                plan.sim_logs
+                    .is_none_or(|names| names.contains(&data::log_name(p).as_str()))
+            })
+            .map(|p| (Kind::Sim2, p)),
         ),
         Err(e) => notes.push(format!("Simulated indoor worlds unavailable: {e:#}.")),
     }

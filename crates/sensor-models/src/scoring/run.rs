@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use nalgebra::{Point2, Point3, Vector2, Vector3};
 use rayon::prelude::*;
-use raypath_geometry::{Aabb2, Aabb3, Grid2, Grid3, Pose2, Pose3, Ray3, Scan2};
+use raypath_geometry::{Aabb2, Aabb3, Grid2, Grid3, Pose2, Pose3, Range, Ray3, Scan2};
 use serde::{Deserialize, Serialize};
 
 use crate::dimension::Dimension;
@@ -12,7 +12,7 @@ use crate::models::SensorModel;
 use crate::scoring::metrics::{Divergences, disc_offsets, divergences};
 use crate::scoring::{ScoringConfig, variants};
 use crate::stats::DenseStats;
-use crate::{MappingConfig, ScanLikelihood, SensorModelError, SensorRange};
+use crate::{MappingConfig, Reading, ScanLikelihood, SensorModelError, SensorRange};
 
 /// The scores of one model variant over all test scans.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -111,8 +111,11 @@ pub fn score_log(
 /// traversal, corrected poses), every model variant from them, and scores the `test`
 /// scans (poses `world_from_laser`).
 ///
-/// The grid covers the mapped hit points and all poses (map and test) with
-/// `margin_m + disc_radius_m` around the poses. The range limit is `config.max_range_m` or
+/// The grid covers everything the mapping rays traversed (each ray up to its return, or up
+/// to `r_max` for a no-return) and all poses (map and test) with `margin_m +
+/// disc_radius_m` around them, so that the no-returns of the test scans cross mapped space
+/// rather than the models' "outside the grid" prior (spec A2), which would otherwise
+/// dominate their scores. The range limit is `config.max_range_m` or
 /// the smallest `max_range_m` of the scans. Work is parallel over test scans (rayon) and
 /// the result does not depend on the thread count.
 pub fn score_planar(
@@ -141,9 +144,12 @@ pub fn score_planar(
     let mut bounds = Aabb2::empty();
     let pad = config.margin_m + config.disc_radius_m;
     for (pose, scan) in map {
-        for point in scan.points(*pose) {
-            if point.coords.iter().all(|v| v.is_finite()) {
-                bounds.extend(&point);
+        for ray in scan.rays(*pose) {
+            if let Some(length) = traced_length(range, ray.range) {
+                let point = ray.at(length);
+                if point.coords.iter().all(|v| v.is_finite()) {
+                    bounds.extend(&point);
+                }
             }
         }
     }
@@ -212,8 +218,9 @@ pub fn score_planar(
 /// map; every `beam_step`-th ray of the `test` scans is scored. The disc is horizontal
 /// (world x–y; the world frame must be z-up); height and attitude stay at the truth.
 ///
-/// The grid covers the mapped endpoints within `r_max` (returns beyond are no-returns) and
-/// the poses with the disc; `config.max_range_m` is required.
+/// The grid covers the traced extent of the mapping rays (returns within `r_max`; returns
+/// beyond and no-returns up to `r_max`) and the poses with the disc;
+/// `config.max_range_m` is required.
 pub fn score_spatial(
     map: &[(Pose3, &[Ray3])],
     test: &[(Pose3, &[Ray3])],
@@ -244,11 +251,11 @@ pub fn score_spatial(
             return Err(invalid("pose", format!("not finite: {pose:?}")));
         }
         for ray in *rays {
-            if let Some(r) = ray.range.hit()
-                && r.is_finite()
-                && r < max_range_m
-            {
-                bounds.extend(&pose.transform_point(&ray.at(r)));
+            if let Some(length) = traced_length(range, ray.range) {
+                let point = pose.transform_point(&ray.at(length));
+                if point.coords.iter().all(|v| v.is_finite()) {
+                    bounds.extend(&point);
+                }
             }
         }
     }
@@ -322,6 +329,16 @@ pub fn score_spatial(
         resolution_m: config.resolution_m,
         max_range_m,
     })
+}
+
+/// How far mapping traces a ray (its return, or `r_max` for a no-return; `None` for a
+/// `sub` reading, which mapping ignores).
+fn traced_length(range: SensorRange, reading: Range) -> Option<f64> {
+    match range.classify(reading) {
+        Reading::Hit(r) => Some(r),
+        Reading::Sup => Some(range.max_range_m),
+        Reading::Sub => None,
+    }
 }
 
 fn check_cells(cells: usize, config: &ScoringConfig) -> Result<(), SensorModelError> {
