@@ -1,22 +1,350 @@
-//! `raypath localize`: Monte-Carlo localization on a log with a map
+//! `raypath localize`: Monte-Carlo localization of a 2-D CARMEN log on a map written by
+//! `raypath map`.
 //!
-//! (Being written for issue 4.)
+//! The map file (`raypath_sensor_models::export::binary`) holds per-cell statistics and
+//! names a sensor model; the command builds that model (or `--model-override`), reads the
+//! log's laser scans and odometry (`world_from_robot` of each scan message: wheel odometry
+//! in a raw log, corrected poses in a corrected log; only increments are used), and runs the
+//! particle filter of `raypath_localizer` (`lidar::track_planar`). With `--ground-truth` (a
+//! corrected CARMEN log or a TUM pose file `t x y z qx qy qz qw`) it evaluates the estimates
+//! every 1 m of ground-truth path and prints the error summary.
+//!
+//! Initial particles: Gaussian (σ 1 m, 0.1 rad) around `--initial`, else the ground truth
+//! at the first scan, else the log's first pose (right for corrected logs).
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use raypath_geometry::Pose2;
+use raypath_io::carmen::{CarmenReader, LaserKind, Record};
+use raypath_localizer::eval::{EvaluationConfig, evaluate_trajectory};
+use raypath_localizer::init::GaussianInit;
+use raypath_localizer::lidar::{
+    LidarConfig, ModelKind, ModelSpec, PlanarStep, Scan2Measurement, TrackConfig, track_planar,
+};
+use raypath_localizer::{PoseTrack, Stamped};
+use raypath_sensor_models::OpticalDepthConfig;
+use raypath_sensor_models::export::{MapFile, MapKind, StoredStats};
+use serde_json::json;
 
 use super::Failure;
+
+/// Largest gap between a ground-truth stamp and a scan stamp that pairs them (the corrected
+/// CARMEN logs print the raw logger stamp with fewer digits), seconds.
+const MATCH_TOLERANCE_SECS: f64 = 2e-3;
 
 /// Arguments of `raypath localize`.
 #[derive(clap::Args)]
 pub struct Args {
+    /// The binary map written by `raypath map` (2-D).
+    #[arg(long, value_name = "M")]
+    pub map: PathBuf,
+    /// A CARMEN log with laser scans and odometry (raw, or corrected).
+    #[arg(long, value_name = "L")]
+    pub log: PathBuf,
+    /// Ground truth: a corrected CARMEN log or a TUM pose file, matched by time.
+    #[arg(long, value_name = "G")]
+    pub ground_truth: Option<PathBuf>,
+    /// Number of particles.
+    #[arg(long, default_value_t = 1000)]
+    pub particles: usize,
+    /// Random seed.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Use this model instead of the one the map names (decay-rate, reflection, endpoint,
+    /// likelihood-field, log-odds).
+    #[arg(long, value_name = "MODEL")]
+    pub model_override: Option<String>,
+    /// Traverse the grid exactly instead of using optical-depth tables (slower).
+    #[arg(long)]
+    pub exact: bool,
+    /// Use every k-th beam.
+    #[arg(long, default_value_t = 1)]
+    pub beam_step: usize,
+    /// The scan counts as this many independent beams (likelihood exponent; 0 = none).
+    #[arg(long, default_value_t = 8.0)]
+    pub effective_beams: f64,
+    /// Initial pose `x,y,theta` (map frame, metres and radians).
+    #[arg(long, value_name = "X,Y,THETA", allow_hyphen_values = true)]
+    pub initial: Option<String>,
+    /// Write the estimates as a TUM trajectory (`t x y z qx qy qz qw`).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
     /// Print one JSON document on standard output.
     #[arg(long)]
     pub json: bool,
 }
 
+/// One scan of the log: stamp, odometry pose, laser pose, scan.
+type LogScan = (f64, Pose2, Pose2, raypath_geometry::Scan2);
+
+fn read_log(path: &Path, json: bool) -> Result<Vec<LogScan>, Failure> {
+    let reader = CarmenReader::open(path).map_err(|e| Failure::input(e, json))?;
+    let mut out = Vec::new();
+    for record in reader {
+        if let Record::Laser(m) = record.map_err(|e| Failure::input(e, json))?
+            && m.kind != LaserKind::Rear
+        {
+            out.push((m.logger_timestamp_secs, m.world_from_robot, m.world_from_laser, m.scan));
+        }
+    }
+    Ok(out)
+}
+
+/// Reads a TUM file `t x y z qx qy qz qw` (comments `#`), keeping x, y and the yaw.
+fn read_tum(path: &Path, json: bool) -> Result<Vec<(f64, Pose2)>, Failure> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))?;
+    let mut out = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let bad = |reason: &str| {
+            Failure::input(format!("{}: line {}: {reason}", path.display(), i + 1), json)
+        };
+        let v: Vec<f64> = line
+            .split_whitespace()
+            .map(str::parse::<f64>)
+            .collect::<Result<_, _>>()
+            .map_err(|_| bad("expected 8 numbers `t x y z qx qy qz qw`"))?;
+        let [t, x, y, _z, qx, qy, qz, qw] = v[..] else {
+            return Err(bad("expected 8 numbers `t x y z qx qy qz qw`"));
+        };
+        if v.iter().any(|c| !c.is_finite()) {
+            return Err(bad("non-finite number"));
+        }
+        let yaw = (2.0 * (qw * qz + qx * qy)).atan2(1.0 - 2.0 * (qy * qy + qz * qz));
+        out.push((t, Pose2::new(x, y, yaw)));
+    }
+    if out.is_empty() {
+        return Err(Failure::input(
+            format!("{}: no poses (neither a CARMEN log with laser scans nor a TUM file)", path.display()),
+            json,
+        ));
+    }
+    Ok(out)
+}
+
+fn parse_initial(text: &str, json: bool) -> Result<Pose2, Failure> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|s| s.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| Failure::input(format!("--initial {text:?}: expected x,y,theta"), json))?;
+    match v[..] {
+        [x, y, theta] if v.iter().all(|c| c.is_finite()) => Ok(Pose2::new(x, y, theta)),
+        _ => Err(Failure::input(format!("--initial {text:?}: expected three finite numbers x,y,theta"), json)),
+    }
+}
+
+/// A failure that is not the user's input.
+fn internal(error: impl std::fmt::Display, json: bool) -> Failure {
+    Failure {
+        message: error.to_string(),
+        bad_input: false,
+        json,
+    }
+}
+
+/// The ground truth as `(stamp, world_from_robot)`, strictly increasing in time.
+fn read_ground_truth(path: &Path, robot_from_laser: Pose2, json: bool) -> Result<Vec<(f64, Pose2)>, Failure> {
+    let carmen = CarmenReader::open(path)
+        .ok()
+        .and_then(|reader| {
+            let mut out = Vec::new();
+            for record in reader {
+                match record {
+                    Ok(Record::Laser(m)) if m.kind != LaserKind::Rear => out
+                        .push((m.logger_timestamp_secs, m.world_from_laser * robot_from_laser.inverse())),
+                    Ok(_) => {}
+                    Err(_) => return None,
+                }
+            }
+            (!out.is_empty()).then_some(out)
+        });
+    let mut poses = match carmen {
+        Some(poses) => poses,
+        None => read_tum(path, json)?,
+    };
+    poses.sort_by(|a, b| a.0.total_cmp(&b.0));
+    poses.dedup_by(|b, a| b.0 <= a.0);
+    Ok(poses)
+}
+
 /// Runs `raypath localize`.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    Err(Failure {
-        message: "raypath localize is not implemented yet".to_owned(),
-        bad_input: false,
-        json: args.json,
-    })
+    let json = args.json;
+    if args.particles == 0 {
+        return Err(Failure::input("--particles must be at least 1", json));
+    }
+    if args.beam_step == 0 {
+        return Err(Failure::input("--beam-step must be at least 1", json));
+    }
+    if !(args.effective_beams.is_finite() && args.effective_beams >= 0.0) {
+        return Err(Failure::input("--effective-beams must be a finite number ≥ 0", json));
+    }
+    let initial = args.initial.as_deref().map(|t| parse_initial(t, json)).transpose()?;
+    let map = MapFile::read_file(&args.map).map_err(|e| Failure::input(e, json))?;
+    let StoredStats::Planar(stats) = &map.stats else {
+        return Err(Failure::input(
+            format!("{}: a 3-D map; raypath localize handles 2-D maps", args.map.display()),
+            json,
+        ));
+    };
+    let kind = match &args.model_override {
+        Some(name) => name.parse::<ModelKind>().map_err(|e| Failure::input(format!("--model-override: {e}"), json))?,
+        None => match map.kind {
+            MapKind::Statistics | MapKind::DecayRate => ModelKind::DecayRate,
+            MapKind::Reflection => ModelKind::Reflection,
+            MapKind::LogOdds => ModelKind::LogOdds,
+            MapKind::LikelihoodField => ModelKind::LikelihoodField,
+        },
+    };
+    let spec = ModelSpec {
+        kind,
+        posterior: map.posterior,
+        tabulated: (!args.exact).then(OpticalDepthConfig::default),
+    };
+    let model = spec
+        .build(stats, map.mapping.range)
+        .map_err(|e| Failure::input(format!("{}: {e}", args.map.display()), json))?;
+
+    let scans = read_log(&args.log, json)?;
+    let Some(first) = scans.first() else {
+        return Err(Failure::input(format!("{}: no laser scans", args.log.display()), json));
+    };
+    let robot_from_laser = first.1.inverse() * first.2;
+    let ground_truth = args
+        .ground_truth
+        .as_deref()
+        .map(|g| read_ground_truth(g, robot_from_laser, json))
+        .transpose()?;
+
+    let gt_stamps: Vec<f64> = ground_truth.iter().flatten().map(|g| g.0).collect();
+    let near_truth = |t: f64| {
+        let i = gt_stamps.partition_point(|s| *s < t);
+        [i.wrapping_sub(1), i]
+            .iter()
+            .filter_map(|&j| gt_stamps.get(j))
+            .any(|s| (s - t).abs() <= MATCH_TOLERANCE_SECS)
+    };
+    let steps: Vec<PlanarStep> = scans
+        .iter()
+        .map(|(t, odom, _, scan)| PlanarStep {
+            stamp_secs: *t,
+            odom_from_robot: *odom,
+            scan: scan.clone(),
+            force_update: near_truth(*t),
+        })
+        .collect();
+    let truth_track = match &ground_truth {
+        Some(g) => Some(
+            PoseTrack::new(g.iter().map(|(t, p)| Stamped::new(*t, *p)))
+                .map_err(|e| Failure::input(format!("{}: {e}", args.ground_truth.as_deref().unwrap_or(Path::new("")).display()), json))?,
+        ),
+        None => None,
+    };
+    let start = initial.unwrap_or_else(|| match &truth_track {
+        Some(track) => track
+            .pose_at(first.0)
+            .unwrap_or_else(|_| track.poses().first().copied().unwrap_or(first.1)),
+        None => first.1,
+    });
+    let lidar = LidarConfig {
+        beam_step: args.beam_step,
+        effective_beams: (args.effective_beams > 0.0).then_some(args.effective_beams),
+    };
+    let measurement = Scan2Measurement::new(model.as_ref(), robot_from_laser, lidar)
+        .map_err(|e| Failure::input(e, json))?;
+    let config = TrackConfig {
+        particles: args.particles,
+        ..TrackConfig::default()
+    };
+    let result = track_planar(&steps, &measurement, &GaussianInit::new(start), &config, args.seed)
+        .map_err(|e| Failure::input(format!("{}: {e}", args.log.display()), json))?;
+
+    if let Some(out) = &args.out {
+        write_tum(out, &result.estimates).map_err(|e| internal(format!("{}: {e}", out.display()), json))?;
+    }
+    let estimate_track = result.track().map_err(|e| internal(e, json))?;
+    let evaluation = match &truth_track {
+        Some(truth) => Some(
+            evaluate_trajectory(truth, &estimate_track, &EvaluationConfig::default())
+                .map_err(|e| internal(e, json))?,
+        ),
+        None => None,
+    };
+    let summary = json!({
+        "map": args.map.display().to_string(),
+        "log": args.log.display().to_string(),
+        "model": spec.label(),
+        "particles": args.particles,
+        "seed": args.seed,
+        "scans": steps.len(),
+        "updates": result.updates,
+        "failed_updates": result.failed_updates,
+        "resamplings": result.resamplings,
+        "final_pose": result.estimates.last().map(|(_, s)| [s.pose.x(), s.pose.y(), s.pose.theta()]),
+        "error": evaluation.as_ref().map(|e| json!({
+            "evaluated_points": e.points.len(),
+            "length_m": e.length_m,
+            "position_mean_m": e.position_m.mean_abs,
+            "position_rmse_m": e.position_m.rmse,
+            "heading_mean_rad": e.heading_rad.mean_abs,
+            "heading_rmse_rad": e.heading_rad.rmse,
+            "lateral_rmse_m": e.lateral_m.rmse,
+            "longitudinal_rmse_m": e.longitudinal_m.rmse,
+            "diverged": e.divergence.diverged(),
+            "divergence_episodes": e.divergence.episodes,
+            "divergence_fraction": e.divergence.fraction_of_time,
+        })),
+    });
+    if json {
+        println!("{summary:#}");
+    } else {
+        println!(
+            "{}: {} scans, {} updates ({} failed), {} particles, model {}",
+            args.log.display(),
+            steps.len(),
+            result.updates,
+            result.failed_updates,
+            args.particles,
+            spec.label()
+        );
+        if let Some(e) = &evaluation {
+            println!(
+                "error over {:.1} m ({} points): position mean {:.3} m, RMSE {:.3} m; heading mean {:.2}°, RMSE {:.2}°; diverged: {} ({} episodes, {:.1} % of the time)",
+                e.length_m,
+                e.points.len(),
+                e.position_m.mean_abs,
+                e.position_m.rmse,
+                e.heading_rad.mean_abs.to_degrees(),
+                e.heading_rad.rmse.to_degrees(),
+                if e.divergence.diverged() { "yes" } else { "no" },
+                e.divergence.episodes,
+                100.0 * e.divergence.fraction_of_time
+            );
+        }
+    }
+    Ok(())
+}
+
+fn write_tum(path: &Path, estimates: &[(usize, Stamped<Pose2>)]) -> std::io::Result<()> {
+    let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(out, "# raypath localize: t x y z qx qy qz qw (world_from_robot, map frame)")?;
+    for (_, s) in estimates {
+        let half = s.pose.theta() / 2.0;
+        writeln!(
+            out,
+            "{:.6} {:.6} {:.6} 0 0 0 {:.9} {:.9}",
+            s.stamp_secs,
+            s.pose.x(),
+            s.pose.y(),
+            half.sin(),
+            half.cos()
+        )?;
+    }
+    out.flush()
 }
