@@ -392,6 +392,15 @@ struct Cell {
     mean_prior: [f64; 2],
 }
 
+/// A p-value in scientific notation; "< 1e-300" when it underflows.
+fn fmt_p(p: f64) -> String {
+    if p == 0.0 {
+        "< 1e-300".to_owned()
+    } else {
+        format!("{p:.1e}")
+    }
+}
+
 /// FMP-conjugate better than MLM and FMP-uniform (the thesis's three algorithms) with
 /// p < 1e-4.
 fn significant(cell: &Cell) -> bool {
@@ -486,14 +495,14 @@ pub fn section(ctx: &EvalContext) -> Result<(String, serde_json::Value)> {
                 fmt_num(c.mean_rho[1], 4),
                 fmt_num(c.mean_rho[2], 4),
                 fmt_num(c.win_vs[0], 3),
-                format!("{:.1e}", c.p_vs[0]),
+                fmt_p(c.p_vs[0]),
                 fmt_num(c.win_vs[1], 3),
-                format!("{:.1e}", c.p_vs[1]),
+                fmt_p(c.p_vs[1]),
                 if ours { "yes" } else { "no" }.to_owned(),
                 if thesis { "yes" } else { "no" }.to_owned(),
                 fmt_num(c.mlm_zeros_per_run, 2),
                 fmt_num(c.mean_rho[3], 4),
-                format!("{} / {:.1e}", fmt_num(c.win_vs[2], 3), c.p_vs[2]),
+                format!("{} / {}", fmt_num(c.win_vs[2], 3), fmt_p(c.p_vs[2])),
                 format!("{:.2}, {:.2}", c.mean_prior[0], c.mean_prior[1]),
             ]);
         }
