@@ -107,7 +107,10 @@ fn quick_config() -> ScoringConfig {
     }
 }
 
-fn split(scans: &[(Pose2, Scan2)]) -> (Vec<(Pose2, &Scan2)>, Vec<(Pose2, &Scan2)>) {
+/// Scans with their poses, borrowed.
+type Scans<'a> = Vec<(Pose2, &'a Scan2)>;
+
+fn split(scans: &[(Pose2, Scan2)]) -> (Scans<'_>, Scans<'_>) {
     let map = scans.iter().step_by(2).map(|(p, s)| (*p, s)).collect();
     let test = scans
         .iter()

@@ -40,7 +40,8 @@ pub(crate) struct Variant<D: Dimension> {
 /// The **endpoint** model of the thesis is "a likelihood field from the distance to the
 /// nearest mapped reflection" with an absolute probability `P` for out-of-range readings:
 /// [`LikelihoodFieldModel`] with `z_hit = 1`, `z_rand = 0` (a pure Gaussian field,
-/// `σ = endpoint_sigma`), `P = 0.05`, normalized per ray. The likelihood-field row is the
+/// `σ = endpoint_sigma`, distances clamped at `max(10σ, 2 m)` so the field's floor is
+/// `e^{−50}`), `P = 0.05`, normalized per ray. The likelihood-field row is the
 /// same model with AMCL's defaults (the uniform `z_rand` term makes it robust to
 /// unexplained returns).
 pub(crate) fn build<D: Dimension>(
