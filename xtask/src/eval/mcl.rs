@@ -32,8 +32,8 @@ use super::{EvalContext, EvalReport};
 use crate::table::{Table, fmt_num};
 use common::Cell;
 
-/// Particles of the 2-D accuracy runs.
-const PARTICLES_2D: usize = 500;
+/// Particles of the 2-D accuracy runs (the thesis's count for its 3-D runs).
+const PARTICLES_2D: usize = 300;
 /// Beam step of the 2-D accuracy runs (every 2nd of 180 beams).
 const BEAM_STEP_2D: usize = 2;
 
@@ -41,25 +41,34 @@ struct Settings {
     seeds: Vec<u64>,
     /// Ground-truth scans per 2-D log (`None` = all).
     gt_scans: Option<usize>,
+    /// Simulated indoor worlds used.
+    indoor_worlds: usize,
     /// Frames of the 3-D drive.
     frames_3d: usize,
+    /// Filter updates per speed measurement (tabulated / exact).
     speed_updates: (usize, usize),
+    /// The 2-D models.
+    models: Vec<ModelSpec>,
 }
 
 fn settings(quick: bool) -> Settings {
     if quick {
         Settings {
             seeds: (1..=3).collect(),
-            gt_scans: Some(100),
-            frames_3d: 60,
-            speed_updates: (60, 4),
+            gt_scans: Some(80),
+            indoor_worlds: 1,
+            frames_3d: 30,
+            speed_updates: (30, 3),
+            models: models_2d()[..4].to_vec(),
         }
     } else {
         Settings {
             seeds: (1..=10).collect(),
-            gt_scans: None,
-            frames_3d: 400,
-            speed_updates: (300, 10),
+            gt_scans: Some(300),
+            indoor_worlds: 3,
+            frames_3d: 200,
+            speed_updates: (200, 10),
+            models: models_2d(),
         }
     }
 }
@@ -78,7 +87,7 @@ fn models_2d() -> Vec<ModelSpec> {
 }
 
 /// The 2-D data sets: name, kind, raw log, corrected log.
-fn datasets_2d(ctx: &EvalContext) -> Result<Vec<(String, &'static str, PathBuf, PathBuf)>> {
+fn datasets_2d(ctx: &EvalContext, indoor_worlds: usize) -> Result<Vec<(String, &'static str, PathBuf, PathBuf)>> {
     let mut out = Vec::new();
     for (name, raw, corrected) in [
         ("intel", "carmen/raw/intel.clf.bz2", "carmen/corrected/intel-corrected.log.gz"),
@@ -92,7 +101,7 @@ fn datasets_2d(ctx: &EvalContext) -> Result<Vec<(String, &'static str, PathBuf, 
         }
     }
     let indoor = crate::generate::ensure("indoor", ctx.quick)?;
-    for world in ["hall", "lab", "office"] {
+    for world in ["office", "hall", "lab"].into_iter().take(indoor_worlds) {
         let find = |stem: &str| {
             ["", ".gz", ".bz2"]
                 .iter()
@@ -116,12 +125,12 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         ..LidarConfig::default()
     };
     let track = planar::track_config(PARTICLES_2D);
-    let specs = models_2d();
+    let specs = s.models.clone();
     let mut cells: Vec<(String, &'static str, Cell)> = Vec::new();
     let mut speed_rows = Vec::new();
     let mut problems_json = Vec::new();
 
-    for (name, kind, raw, corrected) in datasets_2d(ctx)? {
+    for (name, kind, raw, corrected) in datasets_2d(ctx, s.indoor_worlds)? {
         eprintln!("mcl: loading {name}");
         let problem = planar::load(&name, &raw, &corrected, s.gt_scans)?;
         problems_json.push(json!({
@@ -219,6 +228,27 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     })
 }
 
+/// Fixed notes on the set-up (what differs from the thesis).
+const NOTES: &str = "
+## Notes
+
+- **Real vs simulated**: `intel` and `fr079` are real Radish logs (raw odometry and scans; map and ground truth \
+from the corrected logs); `indoor/*` and `urban*` are simulated (`datasets/generated`).
+- **Maps and localization scans**: for the real logs the map is built from all corrected scans, which are the \
+same laser readings as the raw scans with ground truth (the corrected logs are subsampled raw logs), so mapping \
+and localization data are not disjoint there (the thesis's are); the raw scans between them are not in the map. \
+The simulated indoor maps are built from the corrected (noise-free pose) log of the same run; the 3-D maps from \
+the even frames only, localization on the odd ones (disjoint, as in the thesis).
+- **Likelihood exponent**: full-scan likelihoods are far too peaked (Eq. 7.15 treats beams as independent); every \
+model is tempered the same way, `ln p̃ = γ Σ ln p(z_j)` with γ = 8 / (kept beams) (`raypath_localizer::lidar`). \
+The thesis does not say how it kept its filters healthy (erratum A4).
+- **Filter**: systematic resampling when ESS / N < 0.5, estimate = mean of the best 10 % of the particles, 2-D \
+updates after 0.2 m / 0.2 rad of odometry and at every scan with ground truth; 3-D motion from ground-truth \
+increments with the 6-DOF Gaussian noise model (`Gaussian6DofMotionModel::default()`).
+- **Endpoint** = the likelihood field normalized per ray to a density (Sec. 7.6.2); **likelihood-field** = AMCL's \
+unnormalized value; **(FMP)** = full map posterior (ch. 8).
+";
+
 /// Thesis Table 7.2 (position error [m], DEC / REF / END, 300 particles, 3-D).
 const THESIS: [(&str, [f64; 3]); 4] = [
     ("campus", [0.230, 0.284, 0.280]),
@@ -258,15 +288,20 @@ fn report_markdown(
     let mut md = String::new();
     let mode = if ctx.quick {
         format!(
-            "**Quick mode**: {} seeds, the first {} ground-truth scans of each 2-D log, {} frames of the 3-D drive.",
+            "**Quick mode**: {} seeds, the first {} ground-truth scans of each 2-D log, {} simulated indoor world(s), \
+             {} of the 2-D models, {} frames of the 3-D drive.",
             s.seeds.len(),
             s.gt_scans.unwrap_or(0),
+            s.indoor_worlds,
+            s.models.len(),
             s.frames_3d
         )
     } else {
         format!(
-            "Full mode: {} seeds per cell, whole logs, {} frames of the 3-D drive.",
+            "Full mode: {} seeds per cell, the first {} ground-truth scans of each 2-D log (the whole log when shorter), \
+             {} frames of the 3-D drive.",
             s.seeds.len(),
+            s.gt_scans.unwrap_or(0),
             s.frames_3d
         )
     };
@@ -384,7 +419,12 @@ fn report_markdown(
         "\nOne update = predict + weight (rayon over particles) + systematic resampling; measured in this run on the \
          shared 2-core machine.\n",
     );
-    md.push_str(&format!("\n## The ch. 8 corridor\n\n{corridor_markdown}"));
+    md.push_str(NOTES);
+    if corridor_markdown.trim_start().starts_with("## ") {
+        md.push_str(&format!("\n{corridor_markdown}"));
+    } else {
+        md.push_str(&format!("\n## The ch. 8 corridor\n\n{corridor_markdown}"));
+    }
     md
 }
 

@@ -32,6 +32,32 @@
 //! uses the defaults for all of them), so models are compared under equal conditions; it
 //! changes only how peaked the weights are, not where their maximum lies.
 //!
+//! ## Running along a log, choosing a model
+//!
+//! [`track_planar`] runs the filter along a 2-D log ([`PlanarStep`]s: odometry pose and scan)
+//! with AMCL-style update thresholds (0.2 m / 0.2 rad) and forced updates (e.g. at scans
+//! with ground truth); [`ModelSpec`] builds any sensor model of raypath-sensor-models from a
+//! statistics map at run time (exact traversal or optical-depth table), as `raypath
+//! localize` and `cargo xtask eval mcl` do.
+//!
+//! ## Performance
+//!
+//! `RAYPATH_DATA=… cargo bench -p raypath-localizer --bench mcl` (criterion medians; one
+//! full update = predict + weight + resample, 1000 particles × 180 beams, map of the Intel
+//! Research Lab at 0.1 m from the corrected log, both cores of the shared 2-core machine):
+//!
+//! | model | time per update | updates/s | aim |
+//! | --- | --- | --- | --- |
+//! | likelihood field (AMCL, unnormalized) | 4.25 ms | ≈ 235 | ≥ 200 |
+//! | decay-rate, exact traversal | 43.0 ms | ≈ 23 | ≥ 20 |
+//! | decay-rate, optical-depth table | 16.1 ms | ≈ 62 | ≥ 20 |
+//! | reflection, optical-depth table | 21.8 ms | ≈ 46 | ≥ 20 |
+//!
+//! On the synthetic 30 m × 20 m floor (no data): 4.36 ms, 76.5 ms, 29.3 ms and 36.2 ms
+//! (exact traversal pays for the longer rays there). The table answers a ray in O(1) but
+//! with two bilinear look-ups per end in two directions, so it gains 2.5–3× over the exact
+//! traversal on indoor maps with short rays.
+//!
 //! Frames: poses are `world_from_robot`; `robot_from_sensor` is the sensor mounting;
 //! rays in [`SpatialScan`] are in the sensor frame. Metres, radians (REP-103).
 

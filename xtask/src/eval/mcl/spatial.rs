@@ -25,7 +25,7 @@ pub const VOXEL_M: f64 = 0.5;
 /// Particles (thesis Sec. 7.6.1).
 pub const PARTICLES: usize = 300;
 /// Rays kept per localization scan.
-pub const RAYS_PER_SCAN: usize = 400;
+pub const RAYS_PER_SCAN: usize = 200;
 /// Range limits of the simulated HDL-64E as used here, metres.
 const RANGE_M: (f64, f64) = (1.0, 80.0);
 
