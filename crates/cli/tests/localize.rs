@@ -86,8 +86,18 @@ fn localizes_a_simulated_office_with_carmen_and_tum_ground_truth() {
     let (raw, corrected, map) = office(dir.path());
     let tum = dir.path().join("estimate.tum");
     let common = [
-        "localize", "--map", s(&map), "--log", s(&raw), "--particles", "300", "--beam-step",
-        "4", "--seed", "9", "--json",
+        "localize",
+        "--map",
+        s(&map),
+        "--log",
+        s(&raw),
+        "--particles",
+        "300",
+        "--beam-step",
+        "4",
+        "--seed",
+        "9",
+        "--json",
     ];
     let mut args = common.to_vec();
     args.extend(["--ground-truth", s(&corrected), "--out", s(&tum)]);
@@ -137,18 +147,45 @@ fn localizes_a_simulated_office_with_carmen_and_tum_ground_truth() {
     assert!((a - b).abs() < 0.05, "CARMEN {a} vs TUM {b}");
 
     // Without ground truth: no error block; text mode prints the summary line.
-    let out = raypath(&["localize", "--map", s(&map), "--log", s(&raw), "--particles", "100", "--beam-step", "6", "--model-override", "likelihood-field"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = raypath(&[
+        "localize",
+        "--map",
+        s(&map),
+        "--log",
+        s(&raw),
+        "--particles",
+        "100",
+        "--beam-step",
+        "6",
+        "--model-override",
+        "likelihood-field",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("240 scans") && stdout.contains("likelihood-field"), "{stdout}");
+    assert!(
+        stdout.contains("240 scans") && stdout.contains("likelihood-field"),
+        "{stdout}"
+    );
 }
 
 fn expect_input_error(args: &[&str], needles: &[&str]) {
     let out = raypath(args);
-    assert_eq!(out.status.code(), Some(2), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let stderr = String::from_utf8_lossy(&out.stderr);
     for needle in needles {
-        assert!(stderr.contains(needle), "{args:?}: {needle:?} not in {stderr}");
+        assert!(
+            stderr.contains(needle),
+            "{args:?}: {needle:?} not in {stderr}"
+        );
     }
 }
 
@@ -157,7 +194,11 @@ fn bad_input_exits_2_naming_the_file_and_place() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     // A tiny valid map and log.
-    let grid = Grid2::covering(&Aabb2::new(Point2::new(0.0, 0.0), Point2::new(4.0, 4.0)), 0.1).unwrap();
+    let grid = Grid2::covering(
+        &Aabb2::new(Point2::new(0.0, 0.0), Point2::new(4.0, 4.0)),
+        0.1,
+    )
+    .unwrap();
     let map = d.join("ok.map");
     MapFile {
         kind: MapKind::Reflection,
@@ -174,26 +215,86 @@ fn bad_input_exits_2_naming_the_file_and_place() {
     let bytes = std::fs::read(&map).unwrap();
     let truncated = d.join("truncated.map");
     std::fs::write(&truncated, &bytes[..100]).unwrap();
-    expect_input_error(&["localize", "--map", s(&truncated), "--log", s(&log)], &["truncated.map", "byte"]);
+    expect_input_error(
+        &["localize", "--map", s(&truncated), "--log", s(&log)],
+        &["truncated.map", "byte"],
+    );
     // Missing log.
     let missing = d.join("missing.log");
-    expect_input_error(&["localize", "--map", s(&map), "--log", s(&missing)], &["missing.log"]);
+    expect_input_error(
+        &["localize", "--map", s(&map), "--log", s(&missing)],
+        &["missing.log"],
+    );
     // Malformed log line.
     let bad_log = d.join("bad.log");
-    std::fs::write(&bad_log, "FLASER 3 1.0 1.5 2.0 1 1 0 1 1 0 0.5 host 0.5\nFLASER 3 1.0 x\n").unwrap();
-    expect_input_error(&["localize", "--map", s(&map), "--log", s(&bad_log)], &["bad.log", "2"]);
+    std::fs::write(
+        &bad_log,
+        "FLASER 3 1.0 1.5 2.0 1 1 0 1 1 0 0.5 host 0.5\nFLASER 3 1.0 x\n",
+    )
+    .unwrap();
+    expect_input_error(
+        &["localize", "--map", s(&map), "--log", s(&bad_log)],
+        &["bad.log", "2"],
+    );
     // Malformed TUM ground truth.
     let bad_gt = d.join("bad.tum");
     std::fs::write(&bad_gt, "# header\n0.5 1 1 0 0 0 0 1\n0.6 1 1 0 0 0\n").unwrap();
-    expect_input_error(&["localize", "--map", s(&map), "--log", s(&log), "--ground-truth", s(&bad_gt)], &["bad.tum", "line 3"]);
+    expect_input_error(
+        &[
+            "localize",
+            "--map",
+            s(&map),
+            "--log",
+            s(&log),
+            "--ground-truth",
+            s(&bad_gt),
+        ],
+        &["bad.tum", "line 3"],
+    );
     // Bad parameters.
-    expect_input_error(&["localize", "--map", s(&map), "--log", s(&log), "--model-override", "laser"], &["--model-override", "laser"]);
-    expect_input_error(&["localize", "--map", s(&map), "--log", s(&log), "--initial", "1,2"], &["--initial"]);
-    expect_input_error(&["localize", "--map", s(&map), "--log", s(&log), "--particles", "0"], &["--particles"]);
+    expect_input_error(
+        &[
+            "localize",
+            "--map",
+            s(&map),
+            "--log",
+            s(&log),
+            "--model-override",
+            "laser",
+        ],
+        &["--model-override", "laser"],
+    );
+    expect_input_error(
+        &[
+            "localize",
+            "--map",
+            s(&map),
+            "--log",
+            s(&log),
+            "--initial",
+            "1,2",
+        ],
+        &["--initial"],
+    );
+    expect_input_error(
+        &[
+            "localize",
+            "--map",
+            s(&map),
+            "--log",
+            s(&log),
+            "--particles",
+            "0",
+        ],
+        &["--particles"],
+    );
     // A 3-D map.
     let map3 = d.join("three.map");
     let grid3 = raypath_geometry::Grid3::covering(
-        &raypath_geometry::Aabb3::new(nalgebra::Point3::new(0.0, 0.0, 0.0), nalgebra::Point3::new(2.0, 2.0, 2.0)),
+        &raypath_geometry::Aabb3::new(
+            nalgebra::Point3::new(0.0, 0.0, 0.0),
+            nalgebra::Point3::new(2.0, 2.0, 2.0),
+        ),
         0.5,
     )
     .unwrap();
@@ -205,9 +306,19 @@ fn bad_input_exits_2_naming_the_file_and_place() {
     }
     .write_file(&map3)
     .unwrap();
-    expect_input_error(&["localize", "--map", s(&map3), "--log", s(&log)], &["three.map", "3-D"]);
+    expect_input_error(
+        &["localize", "--map", s(&map3), "--log", s(&log)],
+        &["three.map", "3-D"],
+    );
     // JSON mode: the error is also printed as JSON.
-    let out = raypath(&["localize", "--map", s(&truncated), "--log", s(&log), "--json"]);
+    let out = raypath(&[
+        "localize",
+        "--map",
+        s(&truncated),
+        "--log",
+        s(&log),
+        "--json",
+    ]);
     assert_eq!(out.status.code(), Some(2));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(v["error"].as_str().unwrap().contains("truncated.map"));

@@ -122,10 +122,19 @@ fn bench(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(4))
         .throughput(Throughput::Elements(1));
     let specs = [
-        ("likelihood-field", ModelSpec::exact(ModelKind::LikelihoodField)),
+        (
+            "likelihood-field",
+            ModelSpec::exact(ModelKind::LikelihoodField),
+        ),
         ("decay-rate-exact", ModelSpec::exact(ModelKind::DecayRate)),
-        ("decay-rate-tabulated", ModelSpec::tabulated(ModelKind::DecayRate)),
-        ("reflection-tabulated", ModelSpec::tabulated(ModelKind::Reflection)),
+        (
+            "decay-rate-tabulated",
+            ModelSpec::tabulated(ModelKind::DecayRate),
+        ),
+        (
+            "reflection-tabulated",
+            ModelSpec::tabulated(ModelKind::Reflection),
+        ),
     ];
     let motion = OdometryMotionModel::default();
     for (id, spec) in specs {

@@ -8,8 +8,8 @@ use raypath_geometry::{Aabb2, Grid2, Grid3, Pose2, Pose3, Range, Ray3, Scan2};
 use raypath_localizer::eval::{EvaluationConfig, evaluate_trajectory};
 use raypath_localizer::init::GaussianInit;
 use raypath_localizer::lidar::{
-    LidarConfig, ModelKind, ModelSpec, PlanarStep, Scan2Measurement, Scan3Measurement,
-    TrackConfig, track_planar,
+    LidarConfig, ModelKind, ModelSpec, PlanarStep, Scan2Measurement, Scan3Measurement, TrackConfig,
+    track_planar,
 };
 use raypath_localizer::{MeasurementModel, PoseTrack, Stamped};
 use raypath_sensor_models::{
@@ -29,8 +29,20 @@ fn room() -> (DenseStats2, Vec<(Pose2, Scan2)>) {
             .map(|i| {
                 let a = pose.theta() + min + i as f64 * inc;
                 let (c, s) = (a.cos(), a.sin());
-                let tx = if c > 1e-9 { (w - pose.x()) / c } else if c < -1e-9 { -pose.x() / c } else { f64::INFINITY };
-                let ty = if s > 1e-9 { (h - pose.y()) / s } else if s < -1e-9 { -pose.y() / s } else { f64::INFINITY };
+                let tx = if c > 1e-9 {
+                    (w - pose.x()) / c
+                } else if c < -1e-9 {
+                    -pose.x() / c
+                } else {
+                    f64::INFINITY
+                };
+                let ty = if s > 1e-9 {
+                    (h - pose.y()) / s
+                } else if s < -1e-9 {
+                    -pose.y() / s
+                } else {
+                    f64::INFINITY
+                };
                 tx.min(ty)
             })
             .collect();
@@ -126,7 +138,11 @@ fn planar_adapter_equals_scan_likelihood_on_the_laser_pose() {
 #[test]
 fn the_true_pose_scores_best() {
     let (stats, scans) = room();
-    for kind in [ModelKind::DecayRate, ModelKind::Reflection, ModelKind::Endpoint] {
+    for kind in [
+        ModelKind::DecayRate,
+        ModelKind::Reflection,
+        ModelKind::Endpoint,
+    ] {
         let model = ModelSpec::exact(kind)
             .build(&stats, MappingConfig::default().range)
             .unwrap();
@@ -183,7 +199,11 @@ fn spatial_adapter_equals_rays_log_likelihood_on_the_sensor_pose() {
         for j in 0..6 {
             let yaw = -0.8 + 1.6 * i as f64 / 39.0;
             let pitch = -0.05 - 0.04 * j as f64;
-            let d = nalgebra::Vector3::new(yaw.cos() * pitch.cos(), yaw.sin() * pitch.cos(), pitch.sin());
+            let d = nalgebra::Vector3::new(
+                yaw.cos() * pitch.cos(),
+                yaw.sin() * pitch.cos(),
+                pitch.sin(),
+            );
             let t_wall = (8.0 - origin.x) / d.x;
             let t_floor = -origin.z / d.z;
             let t = t_wall.min(t_floor);
@@ -213,7 +233,8 @@ fn spatial_adapter_equals_rays_log_likelihood_on_the_sensor_pose() {
     assert_eq!(scan.len(), rays.len().div_ceil(2));
     let reference = ScanLikelihood::new(&model).with_beam_step(2);
     let world_from_robot = Pose3::from_xyz_rpy(1.1, 0.1, 0.0, 0.0, 0.01, 0.05);
-    let expected = reference.rays_log_likelihood(&(world_from_robot * robot_from_sensor), &rays_in_sensor);
+    let expected =
+        reference.rays_log_likelihood(&(world_from_robot * robot_from_sensor), &rays_in_sensor);
     let got = adapter.log_likelihood(&world_from_robot, &scan);
     assert!(expected.is_finite());
     assert!((got - expected).abs() <= 1e-9 * expected.abs());
@@ -271,9 +292,17 @@ fn simulated_office() -> (DenseStats2, Vec<PlanarStep>, PoseTrack<Pose2>, Pose2)
             scan: scans[k].clone(),
             force_update: true,
         });
-        truth.push(Stamped::new(run.scan_times[k], run.laser_poses[k] * robot_from_laser.inverse()));
+        truth.push(Stamped::new(
+            run.scan_times[k],
+            run.laser_poses[k] * robot_from_laser.inverse(),
+        ));
     }
-    (stats, steps, PoseTrack::new(truth).unwrap(), robot_from_laser)
+    (
+        stats,
+        steps,
+        PoseTrack::new(truth).unwrap(),
+        robot_from_laser,
+    )
 }
 
 #[test]
@@ -326,4 +355,3 @@ fn mcl_converges_on_a_simulated_office_and_is_deterministic_on_1_and_2_threads()
     assert!(late_mean < 0.25, "late mean error {late_mean}");
     assert!(evaluation.heading_rad.mean_abs < 0.1);
 }
-

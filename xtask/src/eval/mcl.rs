@@ -87,17 +87,32 @@ fn models_2d() -> Vec<ModelSpec> {
 }
 
 /// The 2-D data sets: name, kind, raw log, corrected log.
-fn datasets_2d(ctx: &EvalContext, indoor_worlds: usize) -> Result<Vec<(String, &'static str, PathBuf, PathBuf)>> {
+fn datasets_2d(
+    ctx: &EvalContext,
+    indoor_worlds: usize,
+) -> Result<Vec<(String, &'static str, PathBuf, PathBuf)>> {
     let mut out = Vec::new();
     for (name, raw, corrected) in [
-        ("intel", "carmen/raw/intel.clf.bz2", "carmen/corrected/intel-corrected.log.gz"),
-        ("fr079", "carmen/raw/fr079.clf.bz2", "carmen/corrected/freiburg-079-corrected.log.gz"),
+        (
+            "intel",
+            "carmen/raw/intel.clf.bz2",
+            "carmen/corrected/intel-corrected.log.gz",
+        ),
+        (
+            "fr079",
+            "carmen/raw/fr079.clf.bz2",
+            "carmen/corrected/freiburg-079-corrected.log.gz",
+        ),
     ] {
         let (raw, corrected) = (ctx.data(raw), ctx.data(corrected));
         if raw.exists() && corrected.exists() {
             out.push((name.to_owned(), "real", raw, corrected));
         } else {
-            eprintln!("mcl: skipping {name}: {} or {} absent", raw.display(), corrected.display());
+            eprintln!(
+                "mcl: skipping {name}: {} or {} absent",
+                raw.display(),
+                corrected.display()
+            );
         }
     }
     let indoor = crate::generate::ensure("indoor", ctx.quick)?;
@@ -108,9 +123,10 @@ fn datasets_2d(ctx: &EvalContext, indoor_worlds: usize) -> Result<Vec<(String, &
                 .map(|ext| indoor.join(format!("{stem}{ext}")))
                 .find(|p| p.exists())
         };
-        if let (Some(raw), Some(corrected)) =
-            (find(&format!("{world}.clf")), find(&format!("{world}-corrected.log")))
-        {
+        if let (Some(raw), Some(corrected)) = (
+            find(&format!("{world}.clf")),
+            find(&format!("{world}-corrected.log")),
+        ) {
             out.push((format!("indoor/{world}"), "simulated", raw, corrected));
         }
     }
@@ -158,7 +174,8 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             speed_specs.push(ModelSpec::exact(ModelKind::Reflection));
             let bar = ctx.progress(speed_specs.len() as u64, "speed");
             for spec in &speed_specs {
-                let updates = if spec.tabulated.is_some() || spec.kind == ModelKind::LikelihoodField {
+                let updates = if spec.tabulated.is_some() || spec.kind == ModelKind::LikelihoodField
+                {
                     s.speed_updates.0
                 } else {
                     s.speed_updates.1
@@ -186,12 +203,22 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             let bar = ctx.progress((2 * models.len() * s.seeds.len()) as u64, "urban 3-D");
             for (label, model) in &models {
                 cells_3d.push(spatial::run_model(
-                    "urban", label, model.as_ref(), &problem.frames, &s.seeds, || bar.inc(1),
+                    "urban",
+                    label,
+                    model.as_ref(),
+                    &problem.frames,
+                    &s.seeds,
+                    || bar.inc(1),
                 )?);
             }
             for (label, model) in &models {
                 cells_3d.push(spatial::run_model(
-                    "urban*", label, model.as_ref(), &failing, &s.seeds, || bar.inc(1),
+                    "urban*",
+                    label,
+                    model.as_ref(),
+                    &failing,
+                    &s.seeds,
+                    || bar.inc(1),
                 )?);
             }
             bar.finish_and_clear();
@@ -200,7 +227,16 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     }
 
     let (corridor_markdown, corridor_json) = super::corridor::section(ctx)?;
-    let markdown = report_markdown(ctx, &s, &cells, &cells_3d, &speed_rows, frames_3d, map_rays_3d, &corridor_markdown);
+    let markdown = report_markdown(
+        ctx,
+        &s,
+        &cells,
+        &cells_3d,
+        &speed_rows,
+        frames_3d,
+        map_rays_3d,
+        &corridor_markdown,
+    );
     let json = json!({
         "settings": {
             "seeds": s.seeds, "ground_truth_scans_per_log": s.gt_scans,
@@ -261,7 +297,10 @@ const THESIS: [(&str, [f64; 3]); 4] = [
 fn ordering(errors: [f64; 3]) -> String {
     let mut idx = [0usize, 1, 2];
     idx.sort_by(|a, b| errors[*a].total_cmp(&errors[*b]));
-    idx.iter().map(|&i| ["D", "R", "E"][i]).collect::<Vec<_>>().join(" < ")
+    idx.iter()
+        .map(|&i| ["D", "R", "E"][i])
+        .collect::<Vec<_>>()
+        .join(" < ")
 }
 
 fn dre(cells: &[&Cell]) -> Option<[f64; 3]> {
@@ -314,7 +353,15 @@ fn report_markdown(
     ));
 
     md.push_str("## Table 7.2 analogue: 2-D logs\n\n");
-    let mut table = Table::new(["data set", "real/sim", "model", "position error [m]", "heading error [°]", "diverged", "updates/s"]);
+    let mut table = Table::new([
+        "data set",
+        "real/sim",
+        "model",
+        "position error [m]",
+        "heading error [°]",
+        "diverged",
+        "updates/s",
+    ]);
     for (name, kind, c) in cells {
         table.row([
             name.clone(),
@@ -336,7 +383,14 @@ fn report_markdown(
         spatial::PARTICLES,
         spatial::RAYS_PER_SCAN
     ));
-    let mut table = Table::new(["data set", "model", "position error [m]", "heading error [°]", "diverged", "updates/s"]);
+    let mut table = Table::new([
+        "data set",
+        "model",
+        "position error [m]",
+        "heading error [°]",
+        "diverged",
+        "updates/s",
+    ]);
     for c in cells_3d {
         table.row([
             c.dataset.clone(),
@@ -349,8 +403,17 @@ fn report_markdown(
     }
     md.push_str(&table.to_markdown());
 
-    md.push_str("\n## Orderings beside the thesis (D = decay-rate, R = reflection, E = endpoint)\n\n");
-    let mut table = Table::new(["data set", "source", "D [m]", "R [m]", "E [m]", "order (best first)"]);
+    md.push_str(
+        "\n## Orderings beside the thesis (D = decay-rate, R = reflection, E = endpoint)\n\n",
+    );
+    let mut table = Table::new([
+        "data set",
+        "source",
+        "D [m]",
+        "R [m]",
+        "E [m]",
+        "order (best first)",
+    ]);
     for (name, errors) in THESIS {
         table.row([
             name.to_owned(),
@@ -369,17 +432,35 @@ fn report_markdown(
     }
     let mut ours = Vec::new();
     for (name, kind) in &names {
-        let group: Vec<&Cell> = cells.iter().filter(|(n, _, _)| n == name).map(|(_, _, c)| c).collect();
+        let group: Vec<&Cell> = cells
+            .iter()
+            .filter(|(n, _, _)| n == name)
+            .map(|(_, _, c)| c)
+            .collect();
         if let Some(e) = dre(&group) {
             ours.push(e);
-            table.row([name.clone(), format!("ours (2-D, {kind})"), fmt_num(e[0], 3), fmt_num(e[1], 3), fmt_num(e[2], 3), ordering(e)]);
+            table.row([
+                name.clone(),
+                format!("ours (2-D, {kind})"),
+                fmt_num(e[0], 3),
+                fmt_num(e[1], 3),
+                fmt_num(e[2], 3),
+                ordering(e),
+            ]);
         }
     }
     for set in ["urban", "urban*"] {
         let group: Vec<&Cell> = cells_3d.iter().filter(|c| c.dataset == set).collect();
         if let Some(e) = dre(&group) {
             ours.push(e);
-            table.row([set.to_owned(), "ours (3-D, simulated)".to_owned(), fmt_num(e[0], 3), fmt_num(e[1], 3), fmt_num(e[2], 3), ordering(e)]);
+            table.row([
+                set.to_owned(),
+                "ours (3-D, simulated)".to_owned(),
+                fmt_num(e[0], 3),
+                fmt_num(e[1], 3),
+                fmt_num(e[2], 3),
+                ordering(e),
+            ]);
         }
     }
     md.push_str(&table.to_markdown());
@@ -392,9 +473,22 @@ fn report_markdown(
     ));
 
     md.push_str("\n## Filter update rate (2 cores)\n\n");
-    let mut table = Table::new(["map", "model", "particles × beams", "updates/s", "aim", "model build [s]"]);
+    let mut table = Table::new([
+        "map",
+        "model",
+        "particles × beams",
+        "updates/s",
+        "aim",
+        "model build [s]",
+    ]);
     for (map, r) in speed_rows {
-        let aim = if r.model.starts_with("likelihood-field") { "≥ 200" } else if r.model.starts_with("endpoint") { "" } else { "≥ 20" };
+        let aim = if r.model.starts_with("likelihood-field") {
+            "≥ 200"
+        } else if r.model.starts_with("endpoint") {
+            ""
+        } else {
+            "≥ 20"
+        };
         table.row([
             map.clone(),
             r.model.clone(),
@@ -427,4 +521,3 @@ fn report_markdown(
     }
     md
 }
-

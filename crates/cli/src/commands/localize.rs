@@ -85,7 +85,12 @@ fn read_log(path: &Path, json: bool) -> Result<Vec<LogScan>, Failure> {
         if let Record::Laser(m) = record.map_err(|e| Failure::input(e, json))?
             && m.kind != LaserKind::Rear
         {
-            out.push((m.logger_timestamp_secs, m.world_from_robot, m.world_from_laser, m.scan));
+            out.push((
+                m.logger_timestamp_secs,
+                m.world_from_robot,
+                m.world_from_laser,
+                m.scan,
+            ));
         }
     }
     Ok(out)
@@ -102,7 +107,10 @@ fn read_tum(path: &Path, json: bool) -> Result<Vec<(f64, Pose2)>, Failure> {
             continue;
         }
         let bad = |reason: &str| {
-            Failure::input(format!("{}: line {}: {reason}", path.display(), i + 1), json)
+            Failure::input(
+                format!("{}: line {}: {reason}", path.display(), i + 1),
+                json,
+            )
         };
         let v: Vec<f64> = line
             .split_whitespace()
@@ -120,7 +128,10 @@ fn read_tum(path: &Path, json: bool) -> Result<Vec<(f64, Pose2)>, Failure> {
     }
     if out.is_empty() {
         return Err(Failure::input(
-            format!("{}: no poses (neither a CARMEN log with laser scans nor a TUM file)", path.display()),
+            format!(
+                "{}: no poses (neither a CARMEN log with laser scans nor a TUM file)",
+                path.display()
+            ),
             json,
         ));
     }
@@ -135,7 +146,10 @@ fn parse_initial(text: &str, json: bool) -> Result<Pose2, Failure> {
         .map_err(|_| Failure::input(format!("--initial {text:?}: expected x,y,theta"), json))?;
     match v[..] {
         [x, y, theta] if v.iter().all(|c| c.is_finite()) => Ok(Pose2::new(x, y, theta)),
-        _ => Err(Failure::input(format!("--initial {text:?}: expected three finite numbers x,y,theta"), json)),
+        _ => Err(Failure::input(
+            format!("--initial {text:?}: expected three finite numbers x,y,theta"),
+            json,
+        )),
     }
 }
 
@@ -149,21 +163,25 @@ fn internal(error: impl std::fmt::Display, json: bool) -> Failure {
 }
 
 /// The ground truth as `(stamp, world_from_robot)`, strictly increasing in time.
-fn read_ground_truth(path: &Path, robot_from_laser: Pose2, json: bool) -> Result<Vec<(f64, Pose2)>, Failure> {
-    let carmen = CarmenReader::open(path)
-        .ok()
-        .and_then(|reader| {
-            let mut out = Vec::new();
-            for record in reader {
-                match record {
-                    Ok(Record::Laser(m)) if m.kind != LaserKind::Rear => out
-                        .push((m.logger_timestamp_secs, m.world_from_laser * robot_from_laser.inverse())),
-                    Ok(_) => {}
-                    Err(_) => return None,
-                }
+fn read_ground_truth(
+    path: &Path,
+    robot_from_laser: Pose2,
+    json: bool,
+) -> Result<Vec<(f64, Pose2)>, Failure> {
+    let carmen = CarmenReader::open(path).ok().and_then(|reader| {
+        let mut out = Vec::new();
+        for record in reader {
+            match record {
+                Ok(Record::Laser(m)) if m.kind != LaserKind::Rear => out.push((
+                    m.logger_timestamp_secs,
+                    m.world_from_laser * robot_from_laser.inverse(),
+                )),
+                Ok(_) => {}
+                Err(_) => return None,
             }
-            (!out.is_empty()).then_some(out)
-        });
+        }
+        (!out.is_empty()).then_some(out)
+    });
     let mut poses = match carmen {
         Some(poses) => poses,
         None => read_tum(path, json)?,
@@ -183,18 +201,30 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         return Err(Failure::input("--beam-step must be at least 1", json));
     }
     if !(args.effective_beams.is_finite() && args.effective_beams >= 0.0) {
-        return Err(Failure::input("--effective-beams must be a finite number ≥ 0", json));
+        return Err(Failure::input(
+            "--effective-beams must be a finite number ≥ 0",
+            json,
+        ));
     }
-    let initial = args.initial.as_deref().map(|t| parse_initial(t, json)).transpose()?;
+    let initial = args
+        .initial
+        .as_deref()
+        .map(|t| parse_initial(t, json))
+        .transpose()?;
     let map = MapFile::read_file(&args.map).map_err(|e| Failure::input(e, json))?;
     let StoredStats::Planar(stats) = &map.stats else {
         return Err(Failure::input(
-            format!("{}: a 3-D map; raypath localize handles 2-D maps", args.map.display()),
+            format!(
+                "{}: a 3-D map; raypath localize handles 2-D maps",
+                args.map.display()
+            ),
             json,
         ));
     };
     let kind = match &args.model_override {
-        Some(name) => name.parse::<ModelKind>().map_err(|e| Failure::input(format!("--model-override: {e}"), json))?,
+        Some(name) => name
+            .parse::<ModelKind>()
+            .map_err(|e| Failure::input(format!("--model-override: {e}"), json))?,
         None => match map.kind {
             MapKind::Statistics | MapKind::DecayRate => ModelKind::DecayRate,
             MapKind::Reflection => ModelKind::Reflection,
@@ -213,7 +243,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
 
     let scans = read_log(&args.log, json)?;
     let Some(first) = scans.first() else {
-        return Err(Failure::input(format!("{}: no laser scans", args.log.display()), json));
+        return Err(Failure::input(
+            format!("{}: no laser scans", args.log.display()),
+            json,
+        ));
     };
     let robot_from_laser = first.1.inverse() * first.2;
     let ground_truth = args
@@ -241,8 +274,18 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         .collect();
     let truth_track = match &ground_truth {
         Some(g) => Some(
-            PoseTrack::new(g.iter().map(|(t, p)| Stamped::new(*t, *p)))
-                .map_err(|e| Failure::input(format!("{}: {e}", args.ground_truth.as_deref().unwrap_or(Path::new("")).display()), json))?,
+            PoseTrack::new(g.iter().map(|(t, p)| Stamped::new(*t, *p))).map_err(|e| {
+                Failure::input(
+                    format!(
+                        "{}: {e}",
+                        args.ground_truth
+                            .as_deref()
+                            .unwrap_or(Path::new(""))
+                            .display()
+                    ),
+                    json,
+                )
+            })?,
         ),
         None => None,
     };
@@ -262,11 +305,18 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         particles: args.particles,
         ..TrackConfig::default()
     };
-    let result = track_planar(&steps, &measurement, &GaussianInit::new(start), &config, args.seed)
-        .map_err(|e| Failure::input(format!("{}: {e}", args.log.display()), json))?;
+    let result = track_planar(
+        &steps,
+        &measurement,
+        &GaussianInit::new(start),
+        &config,
+        args.seed,
+    )
+    .map_err(|e| Failure::input(format!("{}: {e}", args.log.display()), json))?;
 
     if let Some(out) = &args.out {
-        write_tum(out, &result.estimates).map_err(|e| internal(format!("{}: {e}", out.display()), json))?;
+        write_tum(out, &result.estimates)
+            .map_err(|e| internal(format!("{}: {e}", out.display()), json))?;
     }
     let estimate_track = result.track().map_err(|e| internal(e, json))?;
     let evaluation = match &truth_track {
@@ -333,7 +383,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
 
 fn write_tum(path: &Path, estimates: &[(usize, Stamped<Pose2>)]) -> std::io::Result<()> {
     let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(out, "# raypath localize: t x y z qx qy qz qw (world_from_robot, map frame)")?;
+    writeln!(
+        out,
+        "# raypath localize: t x y z qx qy qz qw (world_from_robot, map frame)"
+    )?;
     for (_, s) in estimates {
         let half = s.pose.theta() / 2.0;
         writeln!(

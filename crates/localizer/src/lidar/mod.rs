@@ -69,6 +69,6 @@ mod spatial;
 
 pub use build::{BoxedPlanarModel, ModelKind, ModelSpec};
 pub use config::LidarConfig;
-pub use run::{PlanarStep, PlanarTrack, TrackConfig, track_planar};
 pub use planar::{PlanarScan, Scan2Measurement};
+pub use run::{PlanarStep, PlanarTrack, TrackConfig, track_planar};
 pub use spatial::{Scan3Measurement, SpatialScan};

@@ -6,9 +6,7 @@ use serde::{Deserialize, Serialize};
 use super::Scan2Measurement;
 use crate::init::GaussianInit;
 use crate::motion::{OdometryControl, OdometryMotionModel};
-use crate::{
-    Estimator, FilterConfig, LocalizerError, ParticleFilter, PoseTrack, Stamped,
-};
+use crate::{Estimator, FilterConfig, LocalizerError, ParticleFilter, PoseTrack, Stamped};
 use raypath_sensor_models::{Planar, SensorModel};
 
 /// One laser scan of a 2-D log with the odometry pose at its time.

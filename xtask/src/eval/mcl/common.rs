@@ -74,7 +74,11 @@ impl Cell {
 
     /// `mean ± std` of the mean heading error in degrees.
     pub fn heading_text(&self) -> String {
-        let v: Vec<f64> = self.runs.iter().map(|r| r.heading_rad.to_degrees()).collect();
+        let v: Vec<f64> = self
+            .runs
+            .iter()
+            .map(|r| r.heading_rad.to_degrees())
+            .collect();
         let (m, s) = mean_std(&v);
         format!("{} ± {}", fmt_num(m, 2), fmt_num(s, 2))
     }

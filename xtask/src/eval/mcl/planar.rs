@@ -43,8 +43,7 @@ pub struct PlanarProblem {
 }
 
 fn read_scans(path: &Path) -> Result<Vec<(f64, Pose2, Pose2, Scan2)>> {
-    let reader =
-        CarmenReader::open(path).with_context(|| format!("opening {}", path.display()))?;
+    let reader = CarmenReader::open(path).with_context(|| format!("opening {}", path.display()))?;
     let mut out = Vec::new();
     for record in reader {
         if let Record::Laser(m) = record? {
@@ -91,7 +90,10 @@ pub fn load(
         }
     }
     let margin = Vector2::new(1.0, 1.0);
-    let grid = Grid2::covering(&Aabb2::new(bounds.min - margin, bounds.max + margin), CELL_M)?;
+    let grid = Grid2::covering(
+        &Aabb2::new(bounds.min - margin, bounds.max + margin),
+        CELL_M,
+    )?;
     let mut stats = DenseStats2::new(grid);
     let refs: Vec<(Pose2, &Scan2)> = corrected_scans.iter().map(|(_, _, p, s)| (*p, s)).collect();
     stats.insert_scans_par(&refs, &mapping);
@@ -124,7 +126,10 @@ pub fn load(
         keep
     });
     if matched.len() < 2 {
-        bail!("{name}: only {} corrected scans matched raw scans", matched.len());
+        bail!(
+            "{name}: only {} corrected scans matched raw scans",
+            matched.len()
+        );
     }
     if let Some(limit) = max_gt_scans {
         matched.truncate(limit.max(2));

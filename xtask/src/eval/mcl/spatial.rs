@@ -117,8 +117,11 @@ pub fn load(root: &Path, frames: usize) -> Result<SpatialProblem> {
     })
 }
 
+/// A boxed 3-D sensor model.
+pub type BoxedSpatialModel = Box<dyn SensorModel<Spatial> + Send + Sync>;
+
 /// The 3-D models of the table: decay-rate, reflection, endpoint.
-pub fn models(problem: &SpatialProblem) -> Result<Vec<(String, Box<dyn SensorModel<Spatial> + Send + Sync>)>> {
+pub fn models(problem: &SpatialProblem) -> Result<Vec<(String, BoxedSpatialModel)>> {
     let range = problem.range;
     let decay = DecayRateModel3::new(
         &problem.stats,
@@ -193,7 +196,8 @@ pub fn run_model(
         let first = frames[0].1;
         let mean = GaussianInit::new(first).sample(&mut ParticleRng::seed_from_u64(seed ^ 0x3d));
         let init = GaussianInit::new(mean);
-        let mut filter = ParticleFilter::from_initializer(&init, PARTICLES, FilterConfig::default(), seed)?;
+        let mut filter =
+            ParticleFilter::from_initializer(&init, PARTICLES, FilterConfig::default(), seed)?;
         let started = Instant::now();
         let mut estimates = Vec::with_capacity(frames.len());
         for (k, ((stamp, pose, _), scan)) in frames.iter().zip(&scans).enumerate() {
@@ -204,7 +208,10 @@ pub fn run_model(
             if filter.update(&measurement, scan).is_ok() {
                 filter.resample_if_needed();
             }
-            estimates.push(Stamped::new(*stamp, filter.estimate(Estimator::BestFraction(0.1))));
+            estimates.push(Stamped::new(
+                *stamp,
+                filter.estimate(Estimator::BestFraction(0.1)),
+            ));
         }
         let seconds = started.elapsed().as_secs_f64();
         let evaluation = evaluate_trajectory(
@@ -224,4 +231,3 @@ pub fn run_model(
         runs,
     })
 }
-

@@ -52,7 +52,8 @@ pub fn measure(problem: &PlanarProblem, spec: &ModelSpec, updates: usize) -> Res
     let started = Instant::now();
     let mut done = 0;
     for pair in steps.windows(2).cycle().take(updates) {
-        let control = OdometryControl::from_poses(&pair[0].odom_from_robot, &pair[1].odom_from_robot);
+        let control =
+            OdometryControl::from_poses(&pair[0].odom_from_robot, &pair[1].odom_from_robot);
         filter.predict(&motion, &control);
         let scan = measurement.prepare(&pair[1].scan);
         if filter.update(&measurement, &scan).is_ok() {
