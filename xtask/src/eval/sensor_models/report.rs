@@ -84,13 +84,16 @@ fn checks() -> Vec<Check> {
                 d("decay-rate") < d("reflection") && d("decay-rate") < d("endpoint")
             },
         ),
-        ("D': a decay-rate row (ML or FMP) lowest of all seven", |r| {
-            let best = r
-                .rows
-                .iter()
-                .min_by(|a, b| a.neg_log_likelihood.total_cmp(&b.neg_log_likelihood));
-            best.is_some_and(|b| b.model == "decay-rate")
-        }),
+        (
+            "D': a decay-rate row (ML or FMP) lowest of all seven",
+            |r| {
+                let best = r
+                    .rows
+                    .iter()
+                    .min_by(|a, b| a.neg_log_likelihood.total_cmp(&b.neg_log_likelihood));
+                best.is_some_and(|b| b.model == "decay-rate")
+            },
+        ),
         ("D': REF < END (Table 7.3a)", |r| {
             value(r, "reflection", false, |x| x.neg_log_likelihood)
                 < value(r, "endpoint", false, |x| x.neg_log_likelihood)
@@ -119,8 +122,12 @@ fn checks() -> Vec<Check> {
     list
 }
 
+/// One check's tally: its label, `(holds, of)` per kind (real, simulated 2-D, simulated
+/// 3-D) and the data sets where it fails.
+type Tally = (&'static str, [(usize, usize); 3], Vec<String>);
+
 /// Per check: how many data sets of each kind satisfy it.
-fn tally(sets: &[DataSet]) -> Vec<(&'static str, [(usize, usize); 3], Vec<String>)> {
+fn tally(sets: &[DataSet]) -> Vec<Tally> {
     let kinds = [Kind::Real, Kind::Sim2, Kind::Sim3];
     checks()
         .into_iter()
@@ -361,19 +368,48 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> String {
     }
     md.push_str(&agreement.to_markdown());
     let total = sets.len();
-    let summary: Vec<String> = tallies
-        .iter()
-        .map(|(label, counts, _)| {
-            let holds: usize = counts.iter().map(|c| c.0).sum();
-            format!("{label}: {holds} of {total}")
-        })
-        .collect();
+    let holds = |counts: &[(usize, usize); 3]| counts.iter().map(|c| c.0).sum::<usize>();
+    let group = |keep: &dyn Fn(usize) -> bool| -> String {
+        let labels: Vec<String> = tallies
+            .iter()
+            .filter(|(_, counts, _)| keep(holds(counts)))
+            .map(|(label, counts, _)| format!("*{label}* ({} of {total})", holds(counts)))
+            .collect();
+        if labels.is_empty() {
+            "none".to_owned()
+        } else {
+            labels.join("; ")
+        }
+    };
     md.push_str(&format!(
-        "\nIn the thesis every one of these orderings holds on all three data sets. Here, \
-         over {total} data sets: {}. Where an ordering fails, the thesis's claim does not \
-         carry over to that data (2-D indoor scans at 0.1 m cells are a different regime from \
-         3-D outdoor scans at 0.5 m voxels); the table says on which data sets.\n",
-        summary.join("; ")
+        "\nIn the thesis every one of these orderings holds on all three of its data sets. \
+         Over our {total} data sets: **holds on every one**: {}. **Holds on most**: {}. \
+         **Fails on most**: {}.\n",
+        group(&|h| h == total),
+        group(&|h| h < total && 2 * h > total),
+        group(&|h| 2 * h <= total),
     ));
+    let inverse_kl_dec = tallies
+        .iter()
+        .find(|(label, _, _)| label.starts_with("inverse KL: DEC"))
+        .map_or(0, |(_, counts, _)| holds(counts));
+    if 2 * inverse_kl_dec <= total {
+        md.push_str(
+            "\n**Why the inverse KL disagrees.** The ray-casting models (DEC, REF, LO and their \
+             posteriors) score a scan with hundreds of rays, and their scan log-likelihoods at \
+             two samples 0.3 m apart differ by tens to hundreds of nats, so `p̂` sits on one \
+             sample; when that is not the sample nearest to the truth (where the σ = 0.05 m \
+             ground truth puts almost all its weight) the cost is d²/(2σ²) nats. The endpoint \
+             and likelihood-field models are smooth in the pose (a 0.2 m Gaussian field) and \
+             spread `p̂` over the nearby samples, which this metric rewards. D' needs no pose \
+             samples and shows no such effect (see its rows above).\n",
+        );
+    }
+    md.push_str(
+        "\nOur data differ from the thesis's in kind — 2-D indoor scans at 0.1 m cells (real \
+         and simulated) and one simulated 3-D drive, against real 3-D outdoor scans at 0.5 m \
+         voxels — so an ordering that fails here is a statement about these data, not a \
+         refutation; the *fails on* column names the data sets.\n",
+    );
     md
 }
