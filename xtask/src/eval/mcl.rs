@@ -279,7 +279,8 @@ the even frames only, localization on the odd ones (disjoint, as in the thesis).
 model is tempered the same way, `ln p̃ = γ Σ ln p(z_j)` with γ = 8 / (kept beams) (`raypath_localizer::lidar`). \
 The thesis does not say how it kept its filters healthy (erratum A4).
 - **Filter**: systematic resampling when ESS / N < 0.5, estimate = mean of the best 10 % of the particles, 2-D \
-updates after 0.2 m / 0.2 rad of odometry and at every scan with ground truth; 3-D motion from ground-truth \
+updates after 0.2 m / 0.2 rad of odometry and at every scan with ground truth, errors evaluated \
+on the estimates at the scans with ground truth (both tracks interpolated over the same stamps); 3-D motion from ground-truth \
 increments with the 6-DOF Gaussian noise model (`Gaussian6DofMotionModel::default()`).
 - **Endpoint** = the likelihood field normalized per ray to a density (Sec. 7.6.2); **likelihood-field** = AMCL's \
 unnormalized value; **(FMP)** = full map posterior (ch. 8).

@@ -318,7 +318,17 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         write_tum(out, &result.estimates)
             .map_err(|e| internal(format!("{}: {e}", out.display()), json))?;
     }
-    let estimate_track = result.track().map_err(|e| internal(e, json))?;
+    // With ground truth paired to scans, evaluate the estimates at those scans only: between
+    // them both tracks are interpolated over the same stamps.
+    let paired = steps.iter().any(|s| s.force_update);
+    let estimate_track = PoseTrack::new(
+        result
+            .estimates
+            .iter()
+            .filter(|(i, _)| !paired || steps.get(*i).is_some_and(|s| s.force_update))
+            .map(|(_, s)| *s),
+    )
+    .map_err(|e| internal(e, json))?;
     let evaluation = match &truth_track {
         Some(truth) => Some(
             evaluate_trajectory(truth, &estimate_track, &EvaluationConfig::default())
