@@ -28,6 +28,7 @@
 //! | estimators: weighted mean, best 10 %, max weight | [`Estimator`] | Schaefer (2020), ch. 12; Markley et al. (2007) for quaternions |
 //! | initial distributions | [`init`] | Schaefer (2020), ch. 7 (Gaussian 1 m / 0.2 m / 0.1 rad), ch. 12 (disc) |
 //! | trajectory errors every 1 m, divergence, relative motion | [`eval`] | Schaefer (2020), ch. 12 |
+//! | lidar scans as measurements (any raypath-sensor-models model; beam step, likelihood exponent), log tracking | [`lidar`] | Schaefer (2020), Eq. 7.15; Thrun et al. §6.4 |
 //!
 //! ## Decisions on the thesis's open points (errata)
 //!
@@ -94,6 +95,8 @@
 //! * [`motion::OdometryMotionModel`]: α1 = α2 = α3 = α4 = 0.2 (ROS AMCL).
 //! * [`init::GaussianInit`]: σ 1 m horizontal, 0.2 m vertical, 0.1 rad (thesis ch. 7).
 //! * [`eval::EvaluationConfig`]: spacing 1 m, divergence threshold 5 m.
+//! * [`lidar::LidarConfig`]: every beam, likelihood exponent γ = 8 / (kept beams);
+//!   [`lidar::TrackConfig`]: 1000 particles, updates after 0.2 m / 0.2 rad.
 //!
 //! ## Performance
 //!
