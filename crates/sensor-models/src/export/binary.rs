@@ -240,7 +240,8 @@ impl MapFile {
         let mut product: u128 = 1;
         for (d, v) in dims.iter_mut().zip(dims_u64) {
             *d = usize::try_from(v).map_err(|_| r.error_at(48, format!("axis of {v} cells")))?;
-            product *= u128::from(v);
+            // Three u64 factors can exceed u128: saturate (any such product is refused below).
+            product = product.saturating_mul(u128::from(v));
         }
         if axes == 2 && origin[2].to_bits() != 0 {
             return Err(r.error_at(
