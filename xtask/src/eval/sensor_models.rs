@@ -71,6 +71,8 @@ const FULL: Plan = Plan {
 
 /// 3-D cell edge (the thesis's voxels).
 const VOXEL_M: f64 = 0.5;
+/// The real 2-D logs are scored a second time at the thesis's voxel edge (section (e)).
+const COARSE_CELL_M: f64 = 0.5;
 /// 3-D range limit: returns beyond count as no-returns (keeps the map box of the drive
 /// section small; the HDL-64E's nominal range is about 120 m).
 const MAX_RANGE_3D_M: f64 = 50.0;
@@ -155,6 +157,12 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         max_test_scans: plan.max_test_scans_2d,
         ..ScoringConfig::default()
     };
+    // The real logs once more at the thesis's cell size (section (e)).
+    let config_coarse = ScoringConfig {
+        resolution_m: COARSE_CELL_M,
+        ..config_2d
+    };
+    let mut coarse = Vec::new();
     let bar = ctx.progress(logs.len() as u64 + 1, "2-D logs");
     for (kind, path) in &logs {
         let name = data::log_name(path);
@@ -163,6 +171,16 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             data::carmen_scans(path).with_context(|| format!("reading {}", path.display()))?;
         let report =
             score_log(&scans, &config_2d).with_context(|| format!("scoring {}", path.display()))?;
+        if *kind == Kind::Real {
+            let report = score_log(&scans, &config_coarse)
+                .with_context(|| format!("scoring {} at {COARSE_CELL_M} m", path.display()))?;
+            coarse.push(DataSet {
+                name: name.clone(),
+                kind: *kind,
+                scans: scans.len(),
+                report,
+            });
+        }
         sets.push(DataSet {
             name,
             kind: *kind,
@@ -225,7 +243,8 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     }
 
     let seconds = started.elapsed().as_secs_f64();
-    let markdown = report::markdown(&sets, &plan_text(&plan, ctx.quick), &notes);
+    let mut markdown = report::markdown(&sets, &plan_text(&plan, ctx.quick), &notes);
+    markdown.push_str(&report::coarse_section(&coarse, COARSE_CELL_M));
     let json = json!({
         "quick": ctx.quick,
         "seed": SEED,
@@ -239,6 +258,15 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             "report": s.report,
         })).collect::<Vec<_>>(),
         "agreement": report::agreement_json(&sets),
+        "real_2d_at_0_5_m": {
+            "cell_m": COARSE_CELL_M,
+            "data_sets": coarse.iter().map(|s| json!({
+                "name": s.name,
+                "scans": s.scans,
+                "report": s.report,
+            })).collect::<Vec<_>>(),
+            "agreement": report::agreement_json(&coarse),
+        },
     });
     Ok(EvalReport {
         name: "sensor-models",

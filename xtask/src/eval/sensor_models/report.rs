@@ -413,3 +413,37 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> String {
     );
     md
 }
+
+/// Section (e): the real 2-D logs scored again at the thesis's cell size, with the
+/// agreement tally of those rows.
+pub fn coarse_section(sets: &[DataSet], cell_m: f64) -> String {
+    if sets.is_empty() {
+        return String::new();
+    }
+    let mut md = format!(
+        "\n### (e) The real 2-D logs at {cell_m} m cells (the thesis's voxel edge)\n\n\
+         Everything as above (same split, test scans, beams, pose samples and seed) except the \
+         cell edge. Coarser cells make the ray-casting models' likelihoods smoother in the pose, \
+         which is the regime of the thesis's 0.5 m voxels.\n\nD'(g‖h):\n\n"
+    );
+    md.push_str(&model_table(sets, |r| r.neg_log_likelihood, sci).to_markdown());
+    md.push_str("\nInverse KL D(h‖g):\n\n");
+    md.push_str(&model_table(sets, |r| r.inverse_kl, |v| fmt_num(v, 2)).to_markdown());
+    md.push_str(&format!(
+        "\nAgreement with the thesis's orderings at {cell_m} m:\n\n"
+    ));
+    let mut agreement = Table::new(["ordering in the thesis", "real 2-D", "fails on"]);
+    for (label, counts, failing) in tally(sets) {
+        agreement.row([
+            label.to_owned(),
+            format!("{}/{}", counts[0].0, counts[0].1),
+            if failing.is_empty() {
+                "—".to_owned()
+            } else {
+                failing.join(", ")
+            },
+        ]);
+    }
+    md.push_str(&agreement.to_markdown());
+    md
+}
