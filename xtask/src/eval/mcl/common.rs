@@ -89,6 +89,32 @@ impl Cell {
         format!("{d}/{}", self.runs.len())
     }
 
+    /// Mean position error over the runs that did not diverge (NaN when all diverged).
+    pub fn converged_position(&self) -> f64 {
+        let v: Vec<f64> = self
+            .runs
+            .iter()
+            .filter(|r| !r.diverged)
+            .map(|r| r.position_m)
+            .collect();
+        mean_std(&v).0
+    }
+
+    /// `mean ± std` of the mean position error over the runs that did not diverge.
+    pub fn converged_text(&self) -> String {
+        let v: Vec<f64> = self
+            .runs
+            .iter()
+            .filter(|r| !r.diverged)
+            .map(|r| r.position_m)
+            .collect();
+        if v.is_empty() {
+            return "–".to_owned();
+        }
+        let (m, s) = mean_std(&v);
+        format!("{} ± {}", fmt_num(m, 3), fmt_num(s, 3))
+    }
+
     /// Mean position error over the runs.
     pub fn mean_position(&self) -> f64 {
         let v: Vec<f64> = self.runs.iter().map(|r| r.position_m).collect();
@@ -114,6 +140,7 @@ impl Cell {
             "position_error_m": {"mean": pm, "std": ps, "per_run": pos},
             "heading_error_rad": {"mean": hm, "std": hs, "per_run": head},
             "diverged_runs": self.runs.iter().filter(|r| r.diverged).count(),
+            "converged_position_error_m": self.converged_position(),
             "updates_per_s": self.updates_per_s(),
         })
     }
