@@ -80,6 +80,7 @@ mod optimize;
 mod ple;
 mod polyline;
 mod rays;
+pub mod svg;
 
 pub use config::{Method, Optimizer, PolylineConfig};
 pub use error::PolylineError;

@@ -9,6 +9,7 @@ mod corridor;
 mod geometry;
 mod io;
 mod mcl;
+mod polylines;
 mod sensor_models;
 mod sim;
 
@@ -103,6 +104,11 @@ const EVALUATIONS: &[(&str, &str, EvalFn)] = &[
         "mcl",
         "Monte-Carlo localization error per sensor model (Table 7.2), ch. 8 corridor, filter speed",
         mcl::run,
+    ),
+    (
+        "polylines",
+        "PLE, PLE+ and the VVL/IEF/SAM baselines on real and simulated scans (Fig. 10.4, Table 10.2)",
+        polylines::run,
     ),
 ];
 

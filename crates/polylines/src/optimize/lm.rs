@@ -13,6 +13,9 @@ use nalgebra::{DMatrix, DVector, Point2, Vector2};
 
 use super::Problem;
 
+/// Largest change of one coordinate in one iteration, metres.
+const MAX_STEP_M: f64 = 0.1;
+
 /// Where vertex `i`'s parameters start and how many there are.
 fn layout(problem: &Problem<'_>) -> Vec<(usize, usize)> {
     let mut offset = 0;
@@ -140,16 +143,24 @@ pub fn run(
             }
         }
         let mut accepted = false;
+        // Damping floor: a vertex that few beams see (a tiny segment between two beams)
+        // must not be thrown far by a nearly singular column.
+        let floor = 1e-3 * (0..dim).map(|i| h[(i, i)]).sum::<f64>() / dim.max(1) as f64 + 1e-12;
         while lambda < 1e12 {
             let mut a = h.clone();
             for i in 0..dim {
-                a[(i, i)] += lambda * (h[(i, i)] + 1e-12);
+                a[(i, i)] += lambda * h[(i, i)].max(floor);
             }
             let Some(chol) = a.cholesky() else {
                 lambda *= 10.0;
                 continue;
             };
-            let step = chol.solve(&(-&g));
+            let mut step = chol.solve(&(-&g));
+            // Trust region: no coordinate moves more than MAX_STEP_M per iteration.
+            let largest = step.amax();
+            if largest > MAX_STEP_M {
+                step *= MAX_STEP_M / largest;
+            }
             let candidate = &x + &step;
             let mut trial_verts = Vec::with_capacity(n);
             if !decode(problem, &candidate, &mut trial_verts) {
