@@ -45,6 +45,9 @@ enum Command {
     /// Monte-Carlo localization of a log in a map written by `raypath map`; with ground truth,
     /// the error summary.
     Localize(commands::localize::Args),
+    /// Extract polylines from the scans of a CARMEN log: maximum-likelihood PLE / PLE+
+    /// (Schaefer ch. 10) or the VVL, IEF, SAM baselines; vertices, RMSE, f, optional SVG.
+    Polylines(commands::polylines::Args),
 }
 
 fn main() -> ExitCode {
@@ -55,6 +58,7 @@ fn main() -> ExitCode {
         Command::Map(args) => commands::map::run(args),
         Command::ScoreModel(args) => commands::score_model::run(args),
         Command::Localize(args) => commands::localize::run(args),
+        Command::Polylines(args) => commands::polylines::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -3,6 +3,7 @@
 pub mod info;
 pub mod localize;
 pub mod map;
+pub mod polylines;
 pub mod score_model;
 pub mod simulate;
 

@@ -1,0 +1,275 @@
+//! `raypath polylines`: maximum-likelihood polylines (PLE, PLE+; Schaefer 2020 ch. 10) or a
+//! baseline (VVL, IEF, SAM) from the scans of a CARMEN log, in the scan frame.
+//!
+//! Prints per scan the vertices, the RMSE of the ray radii and the fraction `f` of reflected
+//! rays the polylines explain; `--svg FILE` draws scan and polylines (one file per scan,
+//! `FILE-<index>.svg` when several scans are selected).
+//!
+//! `--json` prints `{"scans": [{"index", "polylines": [[[x, y], …], …], "rmse", "f"}, …]}`
+//! (scan entries carry exactly these contract keys; `rmse` is `null` when no ray hits the
+//! polylines) plus the top-level keys `log`, `method`, `optimizer`, `max_vertices`,
+//! `max_edge_m`, `removed_residual_m` and `closed` (per scan, per polyline: whether it is a
+//! closed polygon, whose last vertex connects back to the first).
+
+use std::path::{Path, PathBuf};
+
+use raypath_geometry::Scan2;
+use raypath_io::carmen::{CarmenReader, Record};
+use raypath_polylines::metrics::ray_metrics;
+use raypath_polylines::svg::scan_svg;
+use raypath_polylines::{Method, Optimizer, PolylineConfig, Polylines, extract};
+use serde_json::json;
+
+use super::Failure;
+
+/// Arguments of `raypath polylines`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A CARMEN log (plain, .gz or .bz2).
+    pub log: PathBuf,
+    /// Comma-separated 0-based indices of the laser scans to process (default: the first).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "I,J,…",
+        conflicts_with = "all"
+    )]
+    pub scans: Vec<usize>,
+    /// Process every scan of the log.
+    #[arg(long)]
+    pub all: bool,
+    /// J_max: the largest number of vertices per scan.
+    #[arg(long, default_value_t = 20, value_name = "J")]
+    pub vertices: usize,
+    /// Optimize the vertices after extraction (PLE+).
+    #[arg(long)]
+    pub optimize: bool,
+    /// Extractor: ple (default), vvl, ief or sam (baselines). `--optimize` applies to ple.
+    #[arg(long, default_value = "ple", value_name = "NAME")]
+    pub method: String,
+    /// PLE+ solver: lm (Levenberg–Marquardt, default) or nm (Nelder–Mead, as the thesis).
+    #[arg(long, default_value = "lm", value_name = "NAME")]
+    pub solver: String,
+    /// l_max: longest edge between neighbouring endpoints, metres.
+    #[arg(long, default_value_t = 1.0, value_name = "M")]
+    pub max_edge: f64,
+    /// d_rm: residual charged to rays of a removed end segment, metres.
+    #[arg(long, default_value_t = 0.5, value_name = "M")]
+    pub removed_residual: f64,
+    /// Write an SVG picture of scan and polylines.
+    #[arg(long, value_name = "FILE")]
+    pub svg: Option<PathBuf>,
+    /// Print one JSON document on standard output.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// One processed scan.
+struct Extracted {
+    index: usize,
+    map: Polylines,
+    rmse_m: f64,
+    f: f64,
+}
+
+fn config(args: &Args) -> Result<PolylineConfig, Failure> {
+    let method = match (args.method.as_str(), args.optimize) {
+        ("ple", false) => Method::Ple,
+        ("ple", true) => Method::PlePlus,
+        ("vvl", false) => Method::Vvl,
+        ("ief", false) => Method::Ief,
+        ("sam", false) => Method::Sam,
+        ("vvl" | "ief" | "sam", true) => {
+            return Err(Failure::input(
+                format!("--optimize applies to ple only, not {}", args.method),
+                args.json,
+            ));
+        }
+        (other, _) => {
+            return Err(Failure::input(
+                format!("unknown method {other:?}; choose ple, vvl, ief or sam"),
+                args.json,
+            ));
+        }
+    };
+    let optimizer = match args.solver.as_str() {
+        "lm" => Optimizer::LEVENBERG_MARQUARDT,
+        "nm" => Optimizer::NELDER_MEAD,
+        other => {
+            return Err(Failure::input(
+                format!("unknown solver {other:?}; choose lm or nm"),
+                args.json,
+            ));
+        }
+    };
+    let config = PolylineConfig {
+        method,
+        max_vertices: args.vertices,
+        max_edge_m: args.max_edge,
+        removed_residual_m: args.removed_residual,
+        optimizer,
+        ..PolylineConfig::default()
+    };
+    config
+        .validate()
+        .map_err(|e| Failure::input(e, args.json))?;
+    Ok(config)
+}
+
+/// The selected scans `(index, scan)`, read until the last one needed.
+fn read_scans(args: &Args) -> Result<Vec<(usize, Scan2)>, Failure> {
+    let mut wanted: Vec<usize> = if args.scans.is_empty() {
+        vec![0]
+    } else {
+        args.scans.clone()
+    };
+    wanted.sort_unstable();
+    wanted.dedup();
+    let last = wanted.last().copied().unwrap_or(0);
+    let reader = CarmenReader::open(&args.log).map_err(|e| Failure::input(e, args.json))?;
+    let mut scans = Vec::new();
+    let mut index = 0usize;
+    for record in reader {
+        if let Record::Laser(laser) = record.map_err(|e| Failure::input(e, args.json))? {
+            if args.all || wanted.binary_search(&index).is_ok() {
+                scans.push((index, laser.scan));
+            }
+            index += 1;
+            if !args.all && index > last {
+                break;
+            }
+        }
+    }
+    if !args.all && index <= last {
+        return Err(Failure::input(
+            format!(
+                "{}: scan {last} requested, but the log has {index} laser scan(s)",
+                args.log.display()
+            ),
+            args.json,
+        ));
+    }
+    Ok(scans)
+}
+
+fn svg_path(base: &Path, index: usize, several: bool) -> PathBuf {
+    if !several {
+        return base.to_path_buf();
+    }
+    let stem = base
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "polylines".into());
+    base.with_file_name(format!("{stem}-{index}.svg"))
+}
+
+/// Runs `raypath polylines`.
+pub fn run(args: &Args) -> Result<(), Failure> {
+    let config = config(args)?;
+    let scans = read_scans(args)?;
+    let several = scans.len() > 1;
+    let mut results = Vec::with_capacity(scans.len());
+    for (index, scan) in &scans {
+        let place = || format!("{}: scan {index}", args.log.display());
+        let map = extract(scan, &config)
+            .map_err(|e| Failure::input(format!("{}: {e}", place()), args.json))?;
+        let m = ray_metrics(scan, &map)
+            .map_err(|e| Failure::input(format!("{}: {e}", place()), args.json))?;
+        if let Some(base) = &args.svg {
+            let path = svg_path(base, *index, several);
+            std::fs::write(&path, scan_svg(scan, &map, 800.0)).map_err(|e| Failure {
+                message: format!("{}: {e}", path.display()),
+                bad_input: false,
+                json: args.json,
+            })?;
+        }
+        results.push(Extracted {
+            index: *index,
+            map,
+            rmse_m: m.rmse_m,
+            f: m.f,
+        });
+    }
+    if args.json {
+        println!("{}", to_json(args, &config, &results));
+    } else {
+        print_text(args, &config, &results);
+    }
+    Ok(())
+}
+
+fn to_json(args: &Args, config: &PolylineConfig, results: &[Extracted]) -> serde_json::Value {
+    let scans: Vec<_> = results
+        .iter()
+        .map(|r| {
+            let polylines: Vec<Vec<[f64; 2]>> = r
+                .map
+                .lines
+                .iter()
+                .map(|l| l.vertices.iter().map(|v| [v.x, v.y]).collect())
+                .collect();
+            json!({
+                "index": r.index,
+                "polylines": polylines,
+                "rmse": r.rmse_m,
+                "f": r.f,
+            })
+        })
+        .collect();
+    let closed: Vec<Vec<bool>> = results
+        .iter()
+        .map(|r| r.map.lines.iter().map(|l| l.closed).collect())
+        .collect();
+    json!({
+        "scans": scans,
+        "log": args.log.display().to_string(),
+        "method": config.method.name(),
+        "optimizer": (config.method == Method::PlePlus).then(|| config.optimizer.name()),
+        "max_vertices": config.max_vertices,
+        "max_edge_m": config.max_edge_m,
+        "removed_residual_m": config.removed_residual_m,
+        "closed": closed,
+    })
+}
+
+fn print_text(args: &Args, config: &PolylineConfig, results: &[Extracted]) {
+    println!(
+        "{}: {} with at most {} vertices (l_max {} m, d_rm {} m){}",
+        args.log.display(),
+        config.method.name(),
+        config.max_vertices,
+        config.max_edge_m,
+        config.removed_residual_m,
+        if config.method == Method::PlePlus {
+            format!(", solver {}", config.optimizer.name())
+        } else {
+            String::new()
+        }
+    );
+    for r in results {
+        let rmse = if r.rmse_m.is_finite() {
+            format!("{:.1} mm", r.rmse_m * 1e3)
+        } else {
+            "—".into()
+        };
+        println!(
+            "scan {}: {} vertices in {} polyline(s), RMSE {rmse}, f {:.3}",
+            r.index,
+            r.map.vertex_count(),
+            r.map.lines.len(),
+            r.f
+        );
+        for (i, line) in r.map.lines.iter().enumerate() {
+            let points: Vec<String> = line
+                .vertices
+                .iter()
+                .map(|v| format!("({:.3}, {:.3})", v.x, v.y))
+                .collect();
+            println!(
+                "  {} {i}: {}",
+                if line.closed { "polygon" } else { "polyline" },
+                points.join(" ")
+            );
+        }
+    }
+}
