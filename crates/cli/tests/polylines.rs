@@ -93,7 +93,7 @@ fn room_log_follows_the_json_contract() {
         assert_eq!(scan["index"], i);
         let polylines = scan["polylines"].as_array().unwrap();
         let vertices: usize = polylines.iter().map(|p| p.as_array().unwrap().len()).sum();
-        assert!(vertices <= 8 && vertices >= 2, "{vertices} vertices");
+        assert!((2..=8).contains(&vertices), "{vertices} vertices");
         for p in polylines {
             for v in p.as_array().unwrap() {
                 let xy = v.as_array().unwrap();
