@@ -32,6 +32,8 @@ use crate::table::{Table, fmt_num};
 
 const JS: [usize; 5] = [10, 20, 30, 40, 50];
 const NAME: &str = "polylines";
+/// Each extraction runs this often; its time is the fastest run.
+const TIMING_RUNS: usize = 3;
 
 /// One extractor as evaluated.
 #[derive(Clone, Copy)]
@@ -129,9 +131,15 @@ fn evaluate(ctx: &EvalContext, samples: &[Sample], max_edge_m: f64, what: &str) 
                                 optimizer: v.optimizer,
                                 ..PolylineConfig::new(v.method, j)
                             };
-                            let started = Instant::now();
-                            let map = extract(&sample.scan, &config)?;
-                            let secs = started.elapsed().as_secs_f64();
+                            // The fastest of TIMING_RUNS runs: preemption by other jobs
+                            // on a shared machine only ever adds time.
+                            let mut secs = f64::INFINITY;
+                            let mut map = Default::default();
+                            for _ in 0..TIMING_RUNS {
+                                let started = Instant::now();
+                                map = extract(&sample.scan, &config)?;
+                                secs = secs.min(started.elapsed().as_secs_f64());
+                            }
                             let m = ray_metrics(&sample.scan, &map)?;
                             let mut o = Outcome {
                                 rmse_m: m.rmse_m,
@@ -216,10 +224,7 @@ fn fnv(name: &str) -> u64 {
     })
 }
 
-fn real_samples(
-    ctx: &EvalContext,
-    per_log: usize,
-) -> Result<(Vec<Sample>, Vec<LogInfo>)> {
+fn real_samples(ctx: &EvalContext, per_log: usize) -> Result<(Vec<Sample>, Vec<LogInfo>)> {
     let dir = ctx.data("carmen/corrected");
     let mut logs: Vec<PathBuf> = std::fs::read_dir(&dir)
         .map(|entries| {
@@ -437,7 +442,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          rays explained, area error a and IoU (simulation), time per scan; mean ± standard \
          error over scans. PLE+ uses Levenberg–Marquardt (crate default); PLE+ (NM) is the \
          thesis' Nelder–Mead (fminsearch options TolX = TolFun = 1e-2, 200·dim iterations). \
-         Times: one extraction on one thread (scans in parallel on {} threads), release build.\n",
+         Times: one extraction on one thread, fastest of {TIMING_RUNS} runs (scans in parallel on {} threads), release build.\n",
         rayon::current_num_threads()
     );
     let _ = writeln!(md, "## Data\n");
@@ -501,7 +506,12 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         )?;
         let _ = writeln!(
             md,
-            "![RMSE, real](polylines/real-rmse.svg) ![f, real](polylines/real-f.svg)\n"
+            "![RMSE, real](polylines/real-rmse.svg) ![f, real](polylines/real-f.svg)\n\n\
+             IEF and SAM keep one polyline through all returned endpoints (no-returns removed, \
+             as in the thesis), so segments bridge depth jumps (door frames, gaps between \
+             objects); the few rays between the bridged endpoints hit such a segment metres \
+             in front of their endpoint and dominate the mean RMSE. Median RMSE at J = 20: {}.\n",
+            median_rmse(results, 1)
         );
         json_real = variant_json(results);
     }
@@ -770,10 +780,61 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         ));
     }
     let _ = writeln!(md, "{}\n", notes.join("\n"));
+    if let Some(results) = &real_results {
+        let vvl = variant_index("VVL");
+        let lower: Vec<String> = JS
+            .iter()
+            .enumerate()
+            .filter(|(ji, _)| {
+                stat(results, vvl, *ji, |o| o.rmse_m).0 < stat(results, ple, *ji, |o| o.rmse_m).0
+            })
+            .map(|(ji, j)| {
+                format!(
+                    "J = {j} (f {:.3} vs {:.3})",
+                    stat(results, vvl, ji, |o| o.f).0,
+                    stat(results, ple, ji, |o| o.f).0
+                )
+            })
+            .collect();
+        if !lower.is_empty() {
+            let _ = writeln!(
+                md,
+                "Where VVL has a lower RMSE than PLE on real scans it explains fewer rays: {}. \
+                 VVL drops short polylines first (zero area cost) and spends its vertices on \
+                 the long walls it keeps; PLE charges d_rm = 0.5 m for every ray it stops \
+                 explaining and keeps more of the scan. RMSE alone rewards explaining less; the \
+                 thesis' claim that PLE beats all baselines holds here for the pair (RMSE, f) \
+                 but not for RMSE alone against VVL.\n",
+                lower.join(", ")
+            );
+        }
+    }
+    let timing_source = real_results.as_ref().unwrap_or(sr);
+    let mut order: Vec<(f64, &str)> = VARIANTS
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.label != "PLE+ (NM)")
+        .map(|(vi, v)| (stat(timing_source, vi, 1, |o| o.secs).0, v.label))
+        .collect();
+    order.sort_by(|a, b| a.0.total_cmp(&b.0));
     let _ = writeln!(
         md,
-        "Times: the thesis ranks VVL fastest, then IEF, PLE, PLE+, SAM slowest (Table 10.2). \
-         Here every method takes milliseconds or less; see the table above for the measured order."
+        "Times: the thesis ranks VVL fastest, then IEF, PLE, PLE+, and SAM slowest (Table 10.2, \
+         MATLAB). Measured order at J = 20 ({} scans): {}. SAM is no longer the slowest: the \
+         thesis' SAM time reflects its MATLAB implementation, not the algorithm (our SAM refits \
+         every piece in every iteration and still takes well under a millisecond). Each time is \
+         the fastest of three runs, which removes most preemption by other jobs on this shared \
+         2-core machine.",
+        if real_results.is_some() {
+            "real"
+        } else {
+            "simulated"
+        },
+        order
+            .iter()
+            .map(|(t, l)| format!("{l} {:.3} ms", t * 1e3))
+            .collect::<Vec<_>>()
+            .join(" < ")
     );
 
     let json = json!({
@@ -792,6 +853,23 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         markdown: md,
         json,
     })
+}
+
+/// Median RMSE per method at J index `ji`, as "VVL 12.3 mm, …".
+fn median_rmse(results: &Results, ji: usize) -> String {
+    VARIANTS
+        .iter()
+        .enumerate()
+        .map(|(vi, v)| {
+            let mut values: Vec<f64> = results[vi][ji]
+                .iter()
+                .map(|o| o.rmse_m)
+                .filter(|x| x.is_finite())
+                .collect();
+            format!("{} {:.1} mm", v.label, median(&mut values) * 1e3)
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn yes_no(b: bool) -> &'static str {
