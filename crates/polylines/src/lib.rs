@@ -55,6 +55,36 @@
 //! # Ok::<(), raypath_polylines::PolylineError>(())
 //! ```
 //!
+//! ## Crate map
+//!
+//! | module | content |
+//! |---|---|
+//! | `rays` | the scan as unit rays from the sensor; which beams a segment can hit (O(1) by angle) |
+//! | `initial` | Algorithm 1 lines 1–10: polylines through neighbouring endpoints |
+//! | `ple` | Algorithm 1 lines 11–21: greedy removal with a lazily updated heap |
+//! | `optimize` | PLE+: Levenberg–Marquardt (default) and Nelder–Mead |
+//! | `baselines` | VVL, IEF, SAM |
+//! | [`metrics`] | RMSE, f, area error a (both denominators), IoU |
+//! | [`svg`] | a picture of scan and polylines |
+//!
+//! ## Defaults and their sources
+//!
+//! `J_max` = 10 (reference implementation default; the thesis evaluates 10…50), `l_max` =
+//! 1 m and `d_rm` = 0.5 m (thesis experiments), Σ = 1 m² (irrelevant when constant),
+//! `e_max` = ∞, IEF/SAM split threshold 0.01 m (reference implementation), Nelder–Mead
+//! `TolX` = `TolFun` = 1e-2 and 200·dim iterations (MATLAB `fminsearch` as called by the
+//! reference implementation).
+//!
+//! ## Measured performance
+//!
+//! `cargo bench -p raypath-polylines` (criterion, one thread, 20 Intel scans of 180 beams,
+//! J = 20, Intel Xeon, shared 2-core machine): PLE 0.19 ms, PLE+ with Levenberg–Marquardt
+//! 0.30 ms, PLE+ with Nelder–Mead 0.56 ms per scan (thesis, MATLAB: 1.4 s and 2.3 s). On the
+//! full benchmark (`cargo xtask eval polylines`, `docs/results/polylines.md`) PLE+ has the
+//! lowest RMSE of all methods on simulated scans at every J and on real scans up to J = 40;
+//! Levenberg–Marquardt reaches a lower mean RMSE than Nelder–Mead at all J on simulated
+//! scans and equal within ±0.2 mm on real ones, 2–20 times faster — hence the default.
+//!
 //! ## Decisions on the thesis' open points (spec §7)
 //!
 //! * Eq. (10.2) says `J = J_max`; Algorithm 1 stops at `J ≤ J_max` — a removed two-vertex
@@ -70,6 +100,16 @@
 //!   printed) and the ground-truth area (as implemented); IoU besides.
 //! * `l_max`: 1 m by default (thesis text); the evaluation uses ∞ on simulated polygons
 //!   like the reference implementation (the polygons are closed anyway).
+//! * A scan is a closed revolution when the gap between its last and first beam is at most
+//!   4π/K (reference implementation); its endpoints then form one polygon.
+//! * Baselines: IEF and SAM drop the no-returns and run on one sequence of all remaining
+//!   endpoints (thesis); IEF splits at the endpoint farthest from its segment, SAM at the
+//!   endpoint farthest from the piece's total-least-squares line, then merges pieces whose
+//!   joint fit stays within 0.01 m; SAM's vertices are intersections of neighbouring lines
+//!   (the mean of the break point's projections when the lines are nearly parallel or meet
+//!   more than 1 m away). VVL removes Visvalingam's smallest effective triangle area;
+//!   a lone two-vertex polyline vanishes at cost 0 (thesis: "solitary segments are removed
+//!   at zero cost").
 
 mod baselines;
 mod config;

@@ -34,6 +34,8 @@ const JS: [usize; 5] = [10, 20, 30, 40, 50];
 const NAME: &str = "polylines";
 /// Each extraction runs this often; its time is the fastest run.
 const TIMING_RUNS: usize = 3;
+/// Label of the Nelder–Mead PLE+ variant.
+const NM: &str = "PLE+ (NM)";
 
 /// One extractor as evaluated.
 #[derive(Clone, Copy)]
@@ -326,14 +328,12 @@ fn chart(
     f: impl Fn(&Outcome) -> f64,
     scale: f64,
     reference: Option<(f64, &str)>,
-    skip_nm: bool,
+    exclude: &[&str],
 ) -> String {
     let series: Vec<plot::Series> = VARIANTS
         .iter()
         .enumerate()
-        .filter(|(_, v)| {
-            !(skip_nm && v.optimizer == Optimizer::NELDER_MEAD && v.method == Method::PlePlus)
-        })
+        .filter(|(_, v)| !exclude.contains(&v.label))
         .map(|(vi, v)| plot::Series {
             label: v.label.to_owned(),
             color: v.color,
@@ -496,17 +496,31 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
                 |o| o.rmse_m,
                 1e3,
                 None,
-                false,
+                &[],
+            ),
+        )?;
+        write_figure(
+            &fig_dir,
+            "real-rmse-zoom.svg",
+            &chart(
+                results,
+                "Real scans: RMSE without IEF and SAM",
+                "RMSE [mm]",
+                |o| o.rmse_m,
+                1e3,
+                None,
+                &["IEF", "SAM"],
             ),
         )?;
         write_figure(
             &fig_dir,
             "real-f.svg",
-            &chart(results, "Real scans: f", "f", |o| o.f, 1.0, None, true),
+            &chart(results, "Real scans: f", "f", |o| o.f, 1.0, None, &[NM]),
         )?;
         let _ = writeln!(
             md,
-            "![RMSE, real](polylines/real-rmse.svg) ![f, real](polylines/real-f.svg)\n\n\
+            "![RMSE, real](polylines/real-rmse.svg) ![RMSE, real, zoom](polylines/real-rmse-zoom.svg) \
+             ![f, real](polylines/real-f.svg)\n\n\
              IEF and SAM keep one polyline through all returned endpoints (no-returns removed, \
              as in the thesis), so segments bridge depth jumps (door frames, gaps between \
              objects); the few rays between the bridged endpoints hit such a segment metres \
@@ -545,30 +559,44 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             |o| o.rmse_m,
             1e3,
             Some((30.0, "σ_radial")),
-            false,
+            &[],
+        ),
+    )?;
+    write_figure(
+        &fig_dir,
+        "sim-rmse-zoom.svg",
+        &chart(
+            sr,
+            "Simulated: RMSE without SAM",
+            "RMSE [mm]",
+            |o| o.rmse_m,
+            1e3,
+            Some((30.0, "σ_radial")),
+            &["SAM"],
         ),
     )?;
     write_figure(
         &fig_dir,
         "sim-f.svg",
-        &chart(sr, "Simulated: f", "f", |o| o.f, 1.0, None, true),
+        &chart(sr, "Simulated: f", "f", |o| o.f, 1.0, None, &[NM]),
     )?;
     write_figure(
         &fig_dir,
         "sim-a.svg",
         &chart(
             sr,
-            "Simulated: area error a (GT denominator)",
+            "Simulated: area error a (GT denominator), without SAM",
             "a",
             |o| o.a_gt,
             1.0,
             None,
-            false,
+            &["SAM"],
         ),
     )?;
     let _ = writeln!(
         md,
-        "![RMSE, simulated](polylines/sim-rmse.svg) ![f, simulated](polylines/sim-f.svg) \
+        "![RMSE, simulated](polylines/sim-rmse.svg) \
+         ![RMSE, simulated, zoom](polylines/sim-rmse-zoom.svg) ![f, simulated](polylines/sim-f.svg) \
          ![a, simulated](polylines/sim-a.svg)\n"
     );
 
