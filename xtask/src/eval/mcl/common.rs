@@ -115,12 +115,6 @@ impl Cell {
         format!("{} ± {}", fmt_num(m, 3), fmt_num(s, 3))
     }
 
-    /// Mean position error over the runs.
-    pub fn mean_position(&self) -> f64 {
-        let v: Vec<f64> = self.runs.iter().map(|r| r.position_m).collect();
-        mean_std(&v).0
-    }
-
     /// Mean update rate.
     pub fn updates_per_s(&self) -> f64 {
         let v: Vec<f64> = self.runs.iter().map(|r| r.updates_per_s).collect();
