@@ -92,7 +92,7 @@ fn synthetic_log_decay_rate_map_and_round_trip() {
     let max = json["extent"]["max"].as_array().expect("max");
     let (x0, y0) = (min[0].as_f64().unwrap(), min[1].as_f64().unwrap());
     let (x1, y1) = (max[0].as_f64().unwrap(), max[1].as_f64().unwrap());
-    assert!(x0 >= -0.1 && x0 <= 0.0, "x0 = {x0}");
+    assert!((-0.1..=0.0).contains(&x0), "x0 = {x0}");
     assert!(
         (y0 + 2.0).abs() < 0.11 && (y1 - 2.0).abs() < 0.11,
         "y {y0} {y1}"
