@@ -1,0 +1,101 @@
+//! Sufficient statistics of the radial plane error.
+//!
+//! A plane that does not pass through the sensor is `{p : wᵀp = 1}` with `w ∈ ℝ³`
+//! (normal `w/‖w‖`, distance `1/‖w‖`). A ray with unit direction `v` hits it at
+//! `r̂ = 1/(wᵀv)`, so the radial residual of a measured endpoint `p = r v` is
+//!
+//! `ε = r − r̂ = (wᵀp − 1) · r̂`.
+//!
+//! Replacing the unknown `r̂` by the measured radius `r` (a relative error of `ε/r`, i.e.
+//! 0.4 % for 2 cm of noise at 5 m) turns the sum of squared radial residuals into a quadratic
+//! in `w`, `Σ r² (wᵀp − 1)² = wᵀAw − 2bᵀw + c` with `A = Σ r² p pᵀ`, `b = Σ r² p`,
+//! `c = Σ r²`. These ten numbers are additive, so the error of a union of point sets —
+//! every create/extend/merge action of PPE — costs one 3 × 3 solve, independent of the
+//! plane size. [`crate::fit`] refines the result on the exact residuals. Units: metres,
+//! errors in m².
+
+use nalgebra::{Matrix3, Vector3};
+
+/// Additive sufficient statistics of a set of endpoints (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaneStats {
+    /// `Σ r² p pᵀ` (m⁴).
+    pub a: Matrix3<f64>,
+    /// `Σ r² p` (m³).
+    pub b: Vector3<f64>,
+    /// `Σ r²` (m²).
+    pub c: f64,
+    /// Number of endpoints.
+    pub n: usize,
+}
+
+impl Default for PlaneStats {
+    fn default() -> Self {
+        Self {
+            a: Matrix3::zeros(),
+            b: Vector3::zeros(),
+            c: 0.0,
+            n: 0,
+        }
+    }
+}
+
+impl PlaneStats {
+    /// Statistics of one endpoint `p` (sensor frame, metres).
+    pub fn of_point(p: &Vector3<f64>) -> Self {
+        let r2 = p.norm_squared();
+        Self {
+            a: p * p.transpose() * r2,
+            b: p * r2,
+            c: r2,
+            n: 1,
+        }
+    }
+
+    /// Adds another set.
+    pub fn add(&mut self, other: &Self) {
+        self.a += other.a;
+        self.b += other.b;
+        self.c += other.c;
+        self.n += other.n;
+    }
+
+    /// The union of two sets.
+    pub fn union(&self, other: &Self) -> Self {
+        let mut s = *self;
+        s.add(other);
+        s
+    }
+
+    /// The minimizing plane `w` and its (approximate radial) sum of squared errors in m²;
+    /// `None` when the points do not determine a plane (fewer than three points, collinear
+    /// points, or points on a plane through the sensor).
+    pub fn solve(&self) -> Option<(Vector3<f64>, f64)> {
+        if self.n < 3 {
+            return None;
+        }
+        let chol = self.a.cholesky()?;
+        let w = chol.solve(&self.b);
+        let sse = (self.c - self.b.dot(&w)).max(0.0);
+        if !w.iter().all(|x| x.is_finite()) || !sse.is_finite() {
+            return None;
+        }
+        // Reject numerically singular systems: the plane must be well-posed.
+        let scale = self.a.diagonal().max();
+        let min_pivot = chol
+            .l_dirty()
+            .diagonal()
+            .iter()
+            .fold(f64::INFINITY, |m, &d| m.min(d * d));
+        if min_pivot <= scale * 1e-12 {
+            return None;
+        }
+        Some((w, sse))
+    }
+
+    /// The error of the set in m² (`∞` when no plane is determined, `0` for fewer than
+    /// four points in general position, which any plane explains).
+    pub fn error(&self) -> f64 {
+        self.solve().map_or(f64::INFINITY, |(_, e)| e)
+    }
+}
