@@ -34,13 +34,14 @@ impl Default for PpeParams {
 impl PpeParams {
     /// Preset for SynPEB-style scans (500 × 500, σ_rad = 2 cm). The reference
     /// implementation's tuned values live in a binary `paramppe.mat` that the thesis does
-    /// not print; these come from its grids (`√e` in 2 cm steps, `d` in 2 cm steps from
-    /// 2 to 20 cm) and our own search on the generated training split.
+    /// not print; these lie on its grids (`√e` in 2 cm steps, `d` in 2 cm steps from
+    /// 2 to 20 cm): `√e = 0.32 m`, `d = 0.20 m`, picked by a coarse search on generated
+    /// σ = 2 cm scans (`docs/results/synpeb.md`).
     pub fn synpeb() -> Self {
         Self {
-            max_increment_m2: 0.08 * 0.08,
+            max_increment_m2: 0.32 * 0.32,
             max_planes: None,
-            l_max_m: 0.10,
+            l_max_m: 0.20,
             min_points: 10,
         }
     }

@@ -20,6 +20,7 @@ use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 use nalgebra::Vector3;
+use rayon::prelude::*;
 use raypath_geometry::PointCloud;
 
 use crate::error::PlaneError;
@@ -178,6 +179,8 @@ struct State<'a> {
     height: usize,
     params: &'a PpeParams,
     valid: Vec<bool>,
+    /// Statistics of every ray (zero for no-returns).
+    point_stats: Vec<PlaneStats>,
     /// Edge (k, k + 1) usable.
     right: Vec<bool>,
     /// Edge (k, k + width) usable.
@@ -208,12 +211,24 @@ impl<'a> State<'a> {
             }
         }
         let plane_count = valid.iter().filter(|&&v| v).count();
+        let point_stats = points
+            .iter()
+            .zip(&valid)
+            .map(|(p, &ok)| {
+                if ok {
+                    PlaneStats::of_point(p)
+                } else {
+                    PlaneStats::default()
+                }
+            })
+            .collect();
         let mut s = Self {
             points,
             width,
             height,
             params,
             valid,
+            point_stats,
             right,
             down,
             label: vec![NONE; n],
@@ -222,18 +237,22 @@ impl<'a> State<'a> {
             plane_count,
             steps: 0,
         };
-        let mut entries = Vec::new();
-        for k in 0..n {
-            if let Some((key, mask)) = s.best_create(k) {
-                entries.push(Entry {
+        let chunk = n
+            .div_ceil(rayon::current_num_threads().max(1) * 8)
+            .max(1024);
+        let entries: Vec<Entry> = (0..n)
+            .into_par_iter()
+            .with_min_len(chunk)
+            .filter_map(|k| {
+                s.best_create(k).map(|(key, mask)| Entry {
                     key,
                     action: Action::Create {
                         point: k as u32,
                         mask,
                     },
-                });
-            }
-        }
+                })
+            })
+            .collect();
         s.heap = BinaryHeap::from(entries);
         s
     }
@@ -286,7 +305,7 @@ impl<'a> State<'a> {
     fn tetromino_stats(&self, cells: &[usize; 4]) -> PlaneStats {
         let mut s = PlaneStats::default();
         for &c in cells {
-            s.add(&PlaneStats::of_point(&self.points[c]));
+            s.add(&self.point_stats[c]);
         }
         s
     }
@@ -577,7 +596,7 @@ impl<'a> State<'a> {
     }
 
     fn extend(&mut self, plane: u32, k: usize) {
-        let add = PlaneStats::of_point(&self.points[k]);
+        let add = self.point_stats[k];
         let cl = &mut self.clusters[plane as usize];
         cl.stats.add(&add);
         cl.error = cl.stats.error();

@@ -12,6 +12,7 @@ mod mcl;
 mod polylines;
 mod sensor_models;
 mod sim;
+mod synpeb;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -109,6 +110,11 @@ const EVALUATIONS: &[(&str, &str, EvalFn)] = &[
         "polylines",
         "PLE, PLE+ and the VVL/IEF/SAM baselines on real and simulated scans (Fig. 10.4, Table 10.2)",
         polylines::run,
+    ),
+    (
+        "synpeb",
+        "PPE plane extraction on SynPEB-style scans at five noise levels (Table 11.1)",
+        synpeb::run,
     ),
 ];
 
