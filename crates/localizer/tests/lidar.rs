@@ -81,6 +81,7 @@ fn planar_adapter_equals_scan_likelihood_on_the_laser_pose() {
         let plain = LidarConfig {
             beam_step: step,
             effective_beams: None,
+            random_weight: 0.0,
         };
         let adapter = Scan2Measurement::new(&model, robot_from_laser, plain).unwrap();
         let reference = ScanLikelihood::new(&model).with_beam_step(step);
@@ -121,6 +122,7 @@ fn planar_adapter_equals_scan_likelihood_on_the_laser_pose() {
             LidarConfig {
                 beam_step: step,
                 effective_beams: Some(8.0),
+                ..LidarConfig::default()
             },
         )
         .unwrap();
@@ -174,12 +176,14 @@ fn model_spec_parses_names_and_rejects_bad_configs() {
     let bad = LidarConfig {
         beam_step: 0,
         effective_beams: None,
+        ..LidarConfig::default()
     };
     let model = DecayRateModel2::new(&stats, DecayRateConfig::default()).unwrap();
     assert!(Scan2Measurement::new(&model, Pose2::identity(), bad).is_err());
     let bad = LidarConfig {
         beam_step: 1,
         effective_beams: Some(f64::NAN),
+        ..LidarConfig::default()
     };
     assert!(Scan2Measurement::new(&model, Pose2::identity(), bad).is_err());
 }
@@ -219,6 +223,7 @@ fn spatial_adapter_equals_rays_log_likelihood_on_the_sensor_pose() {
         LidarConfig {
             beam_step: 2,
             effective_beams: None,
+            random_weight: 0.0,
         },
     )
     .unwrap();

@@ -298,6 +298,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let lidar = LidarConfig {
         beam_step: args.beam_step,
         effective_beams: (args.effective_beams > 0.0).then_some(args.effective_beams),
+        ..LidarConfig::default()
     };
     let measurement = Scan2Measurement::new(model.as_ref(), robot_from_laser, lidar)
         .map_err(|e| Failure::input(e, json))?;

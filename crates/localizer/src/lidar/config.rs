@@ -13,6 +13,19 @@ pub struct LidarConfig {
     /// kept beams is multiplied by γ = min(1, n / J). Default `Some(8.0)`; `None` keeps
     /// γ = 1 (the plain product of Eq. 7.15).
     pub effective_beams: Option<f64>,
+    /// Weight ε ∈ [0, 1) of a random measurement mixed into every beam:
+    /// `p̃(z_j) = (1 − ε) p(z_j | s, m) + ε / r_max` for a return (AMCL's `z_rand`, Thrun et
+    /// al. 2005, §6.3; `sup` readings are not mixed, see the [module docs](super)).
+    /// Default [`DEFAULT_RANDOM_WEIGHT`]; 0 gives the sensor model's own value.
+    #[serde(default = "default_random_weight")]
+    pub random_weight: f64,
+}
+
+/// The default of [`LidarConfig::random_weight`].
+pub const DEFAULT_RANDOM_WEIGHT: f64 = 0.05;
+
+fn default_random_weight() -> f64 {
+    DEFAULT_RANDOM_WEIGHT
 }
 
 impl Default for LidarConfig {
@@ -20,12 +33,13 @@ impl Default for LidarConfig {
         Self {
             beam_step: 1,
             effective_beams: Some(8.0),
+            random_weight: DEFAULT_RANDOM_WEIGHT,
         }
     }
 }
 
 impl LidarConfig {
-    /// Checks `beam_step ≥ 1` and a positive finite `effective_beams`.
+    /// Checks `beam_step ≥ 1`, a positive finite `effective_beams` and `random_weight ∈ [0, 1)`.
     pub fn validate(&self) -> Result<(), LocalizerError> {
         if self.beam_step == 0 {
             return Err(LocalizerError::InvalidParameter {
@@ -39,6 +53,12 @@ impl LidarConfig {
             return Err(LocalizerError::InvalidParameter {
                 name: "effective_beams",
                 reason: format!("must be positive and finite, got {n}"),
+            });
+        }
+        if !(0.0..1.0).contains(&self.random_weight) {
+            return Err(LocalizerError::InvalidParameter {
+                name: "random_weight",
+                reason: format!("must be in [0, 1), got {}", self.random_weight),
             });
         }
         Ok(())

@@ -4,6 +4,7 @@ use raypath_geometry::{Pose2, Scan2};
 use raypath_sensor_models::{Planar, PreparedScan, ScanLikelihood, SensorModel};
 
 use super::LidarConfig;
+use super::mixture::RandomMixture;
 use crate::{LocalizerError, MeasurementModel};
 
 /// A 2-D scan prepared for weighting many particles: the kept beams' directions and
@@ -36,7 +37,7 @@ impl PlanarScan {
 /// every `beam_step`-th beam (see the [module docs](super)).
 #[derive(Clone, Debug)]
 pub struct Scan2Measurement<M> {
-    scan_likelihood: ScanLikelihood<M>,
+    scan_likelihood: ScanLikelihood<RandomMixture<M>>,
     robot_from_laser: Pose2,
     config: LidarConfig,
 }
@@ -55,8 +56,14 @@ impl<M: SensorModel<Planar>> Scan2Measurement<M> {
                 reason: "must be finite".to_owned(),
             });
         }
+        let range = model.sensor_range();
         Ok(Self {
-            scan_likelihood: ScanLikelihood::new(model).with_beam_step(config.beam_step),
+            scan_likelihood: ScanLikelihood::new(RandomMixture::new(
+                model,
+                range,
+                config.random_weight,
+            ))
+            .with_beam_step(config.beam_step),
             robot_from_laser,
             config,
         })
@@ -64,7 +71,7 @@ impl<M: SensorModel<Planar>> Scan2Measurement<M> {
 
     /// The sensor model.
     pub fn model(&self) -> &M {
-        self.scan_likelihood.model()
+        self.scan_likelihood.model().inner()
     }
 
     /// The laser mounting.

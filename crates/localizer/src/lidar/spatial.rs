@@ -5,6 +5,7 @@ use raypath_geometry::{PointCloud, Pose3, Range, Ray3};
 use raypath_sensor_models::{ScanLikelihood, SensorModel, Spatial};
 
 use super::LidarConfig;
+use super::mixture::RandomMixture;
 use crate::{LocalizerError, MeasurementModel};
 
 /// A 3-D scan prepared for weighting: the kept rays in the **sensor frame** and the
@@ -42,7 +43,7 @@ impl SpatialScan {
 /// over the kept rays (see the [module docs](super)).
 #[derive(Clone, Debug)]
 pub struct Scan3Measurement<M> {
-    scan_likelihood: ScanLikelihood<M>,
+    scan_likelihood: ScanLikelihood<RandomMixture<M>>,
     robot_from_sensor: Pose3,
     config: LidarConfig,
 }
@@ -61,9 +62,14 @@ impl<M: SensorModel<Spatial>> Scan3Measurement<M> {
                 reason: "must be finite".to_owned(),
             });
         }
+        let range = model.sensor_range();
         // Subsampling happens in `prepare_*`; the inner adapter uses every prepared ray.
         Ok(Self {
-            scan_likelihood: ScanLikelihood::new(model),
+            scan_likelihood: ScanLikelihood::new(RandomMixture::new(
+                model,
+                range,
+                config.random_weight,
+            )),
             robot_from_sensor,
             config,
         })
@@ -71,7 +77,7 @@ impl<M: SensorModel<Spatial>> Scan3Measurement<M> {
 
     /// The sensor model.
     pub fn model(&self) -> &M {
-        self.scan_likelihood.model()
+        self.scan_likelihood.model().inner()
     }
 
     /// The configuration.
