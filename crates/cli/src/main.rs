@@ -48,6 +48,12 @@ enum Command {
     /// Extract polylines from the scans of a CARMEN log: maximum-likelihood PLE / PLE+
     /// (Schaefer ch. 10) or the VVL, IEF, SAM baselines; vertices, RMSE, f, optional SVG.
     Polylines(commands::polylines::Args),
+    /// Extract finite planes from an organized PCD scan (PPE, Schaefer ch. 11): labels per
+    /// point and per plane its normal, distance, point count and RMSE.
+    Planes(commands::planes::Args),
+    /// Score a segmentation against ground-truth labels (Hoover et al., T = 0.8): f, k and
+    /// the over-, under-segmented, missed and noise counts.
+    SegcompEval(commands::segcomp_eval::Args),
 }
 
 fn main() -> ExitCode {
@@ -59,6 +65,8 @@ fn main() -> ExitCode {
         Command::ScoreModel(args) => commands::score_model::run(args),
         Command::Localize(args) => commands::localize::run(args),
         Command::Polylines(args) => commands::polylines::run(args),
+        Command::Planes(args) => commands::planes::run(args),
+        Command::SegcompEval(args) => commands::segcomp_eval::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

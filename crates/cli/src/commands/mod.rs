@@ -3,8 +3,10 @@
 pub mod info;
 pub mod localize;
 pub mod map;
+pub mod planes;
 pub mod polylines;
 pub mod score_model;
+pub mod segcomp_eval;
 pub mod simulate;
 
 use std::process::ExitCode;
