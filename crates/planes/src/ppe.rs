@@ -9,9 +9,15 @@
 //! most `n` planes remain ([`PpeParams::max_planes`]). 4-neighbours farther apart than
 //! `l_max` are never joined (the outlier filter `d`).
 //!
-//! The candidates live in one lazy priority queue: an entry records the versions of the
-//! planes it was computed for; a popped entry whose planes changed since is re-evaluated
-//! and pushed again, so only the actions at the front of the queue are ever recomputed.
+//! The candidates live in one lazy priority queue keyed by the increment computed when
+//! they were queued: a popped candidate is re-evaluated for the current planes and executed
+//! if its increment is still no larger than the next key, else queued again; so only the
+//! candidates at the front of the queue are ever recomputed. A final pass re-evaluates
+//! every queued candidate before stopping (stale keys are not lower bounds).
+//!
+//! Cost: seeding evaluates 17 tetrominoes per ray (parallel, rayon); every action costs
+//! O(1) solves plus O(log Q) queue operations; a merge relabels the smaller plane
+//! (O(K log K) relabelling in total). Final exact refits are O(K · iterations).
 //! Each increment costs one 3 × 3 solve on the additive statistics of
 //! [`crate::PlaneStats`]; the planes of the result are refitted on the exact radial
 //! residuals ([`crate::fit::refine`]).
@@ -131,13 +137,10 @@ enum Action {
     Extend {
         plane: u32,
         point: u32,
-        version: u32,
     },
     Merge {
         a: u32,
         b: u32,
-        va: u32,
-        vb: u32,
     },
 }
 
@@ -169,7 +172,6 @@ struct Cluster {
     stats: PlaneStats,
     error: f64,
     members: Vec<u32>,
-    version: u32,
     parent: u32,
 }
 
@@ -186,8 +188,14 @@ struct State<'a> {
     /// Edge (k, k + width) usable.
     down: Vec<bool>,
     label: Vec<u32>,
+    /// Plane of the queued extension of each atomic ray (`NONE`: none queued).
+    pending: Vec<u32>,
     clusters: Vec<Cluster>,
     heap: BinaryHeap<Entry>,
+    /// The initial creation candidates, ascending by key, consumed from `next_create`
+    /// (kept out of the heap: most are void by the time they come up).
+    creates: Vec<Entry>,
+    next_create: usize,
     plane_count: usize,
     steps: usize,
 }
@@ -232,15 +240,18 @@ impl<'a> State<'a> {
             right,
             down,
             label: vec![NONE; n],
+            pending: vec![NONE; n],
             clusters: Vec::new(),
             heap: BinaryHeap::new(),
+            creates: Vec::new(),
+            next_create: 0,
             plane_count,
             steps: 0,
         };
         let chunk = n
             .div_ceil(rayon::current_num_threads().max(1) * 8)
             .max(1024);
-        let entries: Vec<Entry> = (0..n)
+        let mut entries: Vec<Entry> = (0..n)
             .into_par_iter()
             .with_min_len(chunk)
             .filter_map(|k| {
@@ -253,7 +264,8 @@ impl<'a> State<'a> {
                 })
             })
             .collect();
-        s.heap = BinaryHeap::from(entries);
+        entries.par_sort_unstable_by(|a, b| a.key.total_cmp(&b.key));
+        s.creates = entries;
         s
     }
 
@@ -361,67 +373,84 @@ impl<'a> State<'a> {
             }
             let lo = self.label[o];
             if lo == NONE {
+                if self.pending[o] != NONE && self.root(self.pending[o]) == plane {
+                    continue; // already queued; re-evaluated when popped
+                }
                 let key = self.ext_increment(plane, o);
                 if key.is_finite() {
-                    let version = self.clusters[plane as usize].version;
-                    self.heap.push(Entry {
-                        key,
-                        action: Action::Extend {
-                            plane,
-                            point: o as u32,
-                            version,
-                        },
-                    });
+                    self.pending[o] = plane;
+                    let action = Action::Extend {
+                        plane,
+                        point: o as u32,
+                    };
+                    self.heap.push(Entry { key, action });
                 }
             } else if lo != plane {
                 let key = self.mrg_increment(plane, lo);
                 if key.is_finite() {
-                    let (va, vb) = (
-                        self.clusters[plane as usize].version,
-                        self.clusters[lo as usize].version,
-                    );
                     self.heap.push(Entry {
                         key,
-                        action: Action::Merge {
-                            a: plane,
-                            b: lo,
-                            va,
-                            vb,
-                        },
+                        action: Action::Merge { a: plane, b: lo },
                     });
                 }
             }
         }
     }
 
-    fn stop(&self, key: f64) -> bool {
-        key > self.params.max_increment_m2
-            || self
-                .params
-                .max_planes
-                .is_some_and(|n| self.plane_count <= n)
+    /// The least key queued in the heap or the sorted creates.
+    fn peek_key(&self) -> Option<f64> {
+        let h = self.heap.peek().map(|e| e.key);
+        let c = self.creates.get(self.next_create).map(|e| e.key);
+        match (h, c) {
+            (Some(h), Some(c)) => Some(h.min(c)),
+            (h, c) => h.or(c),
+        }
     }
 
-    /// Runs the clustering; when the least fresh increment exceeds `e`, re-evaluates every
-    /// queued candidate once (stale keys are not lower bounds) and resumes if any is now
-    /// admissible; candidates still above `e` are dropped.
+    /// Pops the least entry of the heap and the sorted creates.
+    fn pop(&mut self) -> Option<Entry> {
+        let c = self.creates.get(self.next_create).copied();
+        match (self.heap.peek(), c) {
+            (Some(h), Some(c)) if c.key < h.key => {
+                self.next_create += 1;
+                Some(c)
+            }
+            (None, Some(c)) => {
+                self.next_create += 1;
+                Some(c)
+            }
+            _ => self.heap.pop(),
+        }
+    }
+
+    fn stop(&self, key: f64) -> bool {
+        key > self.params.max_increment_m2 || self.plane_limit_reached()
+    }
+
+    fn plane_limit_reached(&self) -> bool {
+        self.params
+            .max_planes
+            .is_some_and(|n| self.plane_count <= n)
+    }
+
+    /// Runs the clustering; when the least increment exceeds `e`, re-evaluates every
+    /// queued candidate once and resumes if any is now admissible; candidates still above
+    /// `e` are dropped.
     fn run(&mut self) {
         loop {
             self.run_until_stop();
-            if self
-                .params
-                .max_planes
-                .is_some_and(|n| self.plane_count <= n)
-            {
+            if self.plane_limit_reached() {
                 return;
             }
-            let old = std::mem::take(&mut self.heap).into_vec();
+            let mut old = std::mem::take(&mut self.heap).into_vec();
+            old.extend(self.creates.drain(self.next_create..));
+            self.next_create = 0;
             let mut fresh = Vec::new();
             for entry in old {
-                if let Some(e) = self.reevaluate(entry) {
-                    if e.key <= self.params.max_increment_m2 {
-                        fresh.push(e);
-                    }
+                if let Some(e) = self.reevaluate(entry)
+                    && e.key <= self.params.max_increment_m2
+                {
+                    fresh.push(e);
                 }
             }
             if fresh.is_empty() {
@@ -441,148 +470,77 @@ impl<'a> State<'a> {
                     action: Action::Create { point, mask },
                 })
             }
-            Action::Extend { plane, point, .. } => {
+            Action::Extend { plane, point } => {
                 if self.label[point as usize] != NONE {
                     return None;
                 }
                 let r = self.root(plane);
                 let key = self.ext_increment(r, point as usize);
-                let version = self.clusters[r as usize].version;
                 key.is_finite().then_some(Entry {
                     key,
-                    action: Action::Extend {
-                        plane: r,
-                        point,
-                        version,
-                    },
+                    action: Action::Extend { plane: r, point },
                 })
             }
-            Action::Merge { a, b, .. } => {
+            Action::Merge { a, b } => {
                 let (ra, rb) = (self.root(a), self.root(b));
                 if ra == rb {
                     return None;
                 }
                 let key = self.mrg_increment(ra, rb);
-                let (va, vb) = (
-                    self.clusters[ra as usize].version,
-                    self.clusters[rb as usize].version,
-                );
                 key.is_finite().then_some(Entry {
                     key,
-                    action: Action::Merge {
-                        a: ra,
-                        b: rb,
-                        va,
-                        vb,
-                    },
+                    action: Action::Merge { a: ra, b: rb },
                 })
             }
         }
     }
 
+    /// Lazy greedy loop: a popped candidate is re-evaluated for the current planes; it is
+    /// executed when its current increment is still no larger than the next queued key,
+    /// otherwise queued again with the new key.
     fn run_until_stop(&mut self) {
-        while let Some(entry) = self.heap.pop() {
-            if self
-                .params
-                .max_planes
-                .is_some_and(|n| self.plane_count <= n)
-            {
+        while let Some(entry) = self.pop() {
+            if self.plane_limit_reached() {
                 break;
             }
-            match entry.action {
+            if let Action::Extend { point, .. } = entry.action {
+                self.pending[point as usize] = NONE;
+            }
+            let Some(current) = self.reevaluate(entry) else {
+                continue;
+            };
+            if let Action::Extend { plane, point } = current.action {
+                self.pending[point as usize] = plane;
+            }
+            let still_least =
+                current.key <= entry.key || self.peek_key().is_none_or(|next| current.key <= next);
+            if !still_least {
+                self.heap.push(current);
+                continue;
+            }
+            if self.stop(current.key) {
+                self.heap.push(current);
+                break;
+            }
+            match current.action {
                 Action::Create { point, mask } => {
-                    let k = point as usize;
-                    match self.tetromino(k, mask as usize) {
-                        Some(cells) => {
-                            if self.stop(entry.key) {
-                                self.heap.push(entry);
-                                break;
-                            }
-                            self.create(cells, entry.key);
-                        }
-                        None => {
-                            if let Some((key, mask)) = self.best_create(k) {
-                                self.heap.push(Entry {
-                                    key,
-                                    action: Action::Create { point, mask },
-                                });
-                            }
-                        }
+                    if let Some(cells) = self.tetromino(point as usize, mask as usize) {
+                        self.create(cells);
                     }
                 }
-                Action::Extend {
-                    plane,
-                    point,
-                    version,
-                } => {
-                    let k = point as usize;
-                    if self.label[k] != NONE {
-                        continue;
-                    }
-                    let r = self.root(plane);
-                    let v = self.clusters[r as usize].version;
-                    if r != plane || v != version {
-                        let key = self.ext_increment(r, k);
-                        if key.is_finite() {
-                            self.heap.push(Entry {
-                                key,
-                                action: Action::Extend {
-                                    plane: r,
-                                    point,
-                                    version: v,
-                                },
-                            });
-                        }
-                        continue;
-                    }
-                    if self.stop(entry.key) {
-                        self.heap.push(entry);
-                        break;
-                    }
-                    self.extend(r, k);
-                }
-                Action::Merge { a, b, va, vb } => {
-                    let (ra, rb) = (self.root(a), self.root(b));
-                    if ra == rb {
-                        continue;
-                    }
-                    let (wa, wb) = (
-                        self.clusters[ra as usize].version,
-                        self.clusters[rb as usize].version,
-                    );
-                    if ra != a || rb != b || wa != va || wb != vb {
-                        let key = self.mrg_increment(ra, rb);
-                        if key.is_finite() {
-                            self.heap.push(Entry {
-                                key,
-                                action: Action::Merge {
-                                    a: ra,
-                                    b: rb,
-                                    va: wa,
-                                    vb: wb,
-                                },
-                            });
-                        }
-                        continue;
-                    }
-                    if self.stop(entry.key) {
-                        self.heap.push(entry);
-                        break;
-                    }
-                    self.merge(ra, rb);
-                }
+                Action::Extend { plane, point } => self.extend(plane, point as usize),
+                Action::Merge { a, b } => self.merge(a, b),
             }
         }
     }
 
-    fn create(&mut self, cells: [usize; 4], _key: f64) {
+    fn create(&mut self, cells: [usize; 4]) {
         let id = self.clusters.len() as u32;
         let stats = self.tetromino_stats(&cells);
         self.clusters.push(Cluster {
             stats,
             error: stats.error(),
             members: cells.iter().map(|&c| c as u32).collect(),
-            version: 0,
             parent: id,
         });
         for &c in &cells {
@@ -601,7 +559,6 @@ impl<'a> State<'a> {
         cl.stats.add(&add);
         cl.error = cl.stats.error();
         cl.members.push(k as u32);
-        cl.version += 1;
         self.label[k] = plane;
         self.plane_count -= 1;
         self.steps += 1;
@@ -625,30 +582,32 @@ impl<'a> State<'a> {
         cl.stats.add(&small_stats);
         cl.error = cl.stats.error();
         cl.members.extend(moved);
-        cl.version += 1;
         self.plane_count -= 1;
         self.steps += 1;
     }
 
     fn finish(self) -> Segmentation {
-        let mut planes: Vec<Plane> = Vec::new();
-        let mut buf = Vec::new();
-        for (id, cl) in self.clusters.iter().enumerate() {
-            if cl.parent as usize != id || cl.members.len() < self.params.min_points.max(4) {
-                continue;
-            }
-            let Some((w0, _)) = cl.stats.solve() else {
-                continue;
-            };
-            buf.clear();
-            buf.extend(cl.members.iter().map(|&m| self.points[m as usize]));
-            let Some(fit) = refine(w0, &buf, 1e-6, 20) else {
-                continue;
-            };
-            let mut index: Vec<usize> = cl.members.iter().map(|&m| m as usize).collect();
-            index.sort_unstable();
-            planes.push(Plane { index, fit });
-        }
+        let min_points = self.params.min_points.max(4);
+        let alive: Vec<&Cluster> = self
+            .clusters
+            .iter()
+            .enumerate()
+            .filter(|(id, cl)| cl.parent as usize == *id && cl.members.len() >= min_points)
+            .map(|(_, cl)| cl)
+            .collect();
+        let points = self.points;
+        let mut planes: Vec<Plane> = alive
+            .into_par_iter()
+            .filter_map(|cl| {
+                let (w0, _) = cl.stats.solve()?;
+                let buf: Vec<Vector3<f64>> =
+                    cl.members.iter().map(|&m| points[m as usize]).collect();
+                let fit = refine(w0, &buf, 1e-6, 20)?;
+                let mut index: Vec<usize> = cl.members.iter().map(|&m| m as usize).collect();
+                index.sort_unstable();
+                Some(Plane { index, fit })
+            })
+            .collect();
         planes.sort_by(|a, b| {
             b.index
                 .len()

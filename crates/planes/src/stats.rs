@@ -74,20 +74,36 @@ impl PlaneStats {
         if self.n < 3 {
             return None;
         }
-        let chol = self.a.cholesky()?;
-        let w = chol.solve(&self.b);
-        let sse = (self.c - self.b.dot(&w)).max(0.0);
-        if !w.iter().all(|x| x.is_finite()) || !sse.is_finite() {
+        // Symmetric 3 × 3 solve by cofactors (A is positive semi-definite).
+        let a = &self.a;
+        let (a00, a01, a02, a11, a12, a22) = (
+            a[(0, 0)],
+            a[(0, 1)],
+            a[(0, 2)],
+            a[(1, 1)],
+            a[(1, 2)],
+            a[(2, 2)],
+        );
+        let c00 = a11 * a22 - a12 * a12;
+        let c01 = a02 * a12 - a01 * a22;
+        let c02 = a01 * a12 - a02 * a11;
+        let c11 = a00 * a22 - a02 * a02;
+        let c12 = a01 * a02 - a00 * a12;
+        let c22 = a00 * a11 - a01 * a01;
+        let det = a00 * c00 + a01 * c01 + a02 * c02;
+        // Reject numerically singular systems (collinear points, planes through the sensor).
+        let scale = a00.max(a11).max(a22);
+        if det.is_nan() || det <= scale * scale * scale * 1e-15 {
             return None;
         }
-        // Reject numerically singular systems: the plane must be well-posed.
-        let scale = self.a.diagonal().max();
-        let min_pivot = chol
-            .l_dirty()
-            .diagonal()
-            .iter()
-            .fold(f64::INFINITY, |m, &d| m.min(d * d));
-        if min_pivot <= scale * 1e-12 {
+        let b = &self.b;
+        let w = Vector3::new(
+            c00 * b.x + c01 * b.y + c02 * b.z,
+            c01 * b.x + c11 * b.y + c12 * b.z,
+            c02 * b.x + c12 * b.y + c22 * b.z,
+        ) / det;
+        let sse = (self.c - b.dot(&w)).max(0.0);
+        if !w.iter().all(|x| x.is_finite()) || !sse.is_finite() {
             return None;
         }
         Some((w, sse))
