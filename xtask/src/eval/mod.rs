@@ -10,6 +10,7 @@ mod geometry;
 mod io;
 mod mcl;
 mod polylines;
+mod segcomp;
 mod sensor_models;
 mod sim;
 mod synpeb;
@@ -115,6 +116,11 @@ const EVALUATIONS: &[(&str, &str, EvalFn)] = &[
         "synpeb",
         "PPE plane extraction on SynPEB-style scans at five noise levels (Table 11.1)",
         synpeb::run,
+    ),
+    (
+        "segcomp",
+        "PPE on the SegComp Perceptron scans when installed (Table 11.1); else how to get them",
+        segcomp::run,
     ),
 ];
 
