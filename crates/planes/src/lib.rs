@@ -14,6 +14,7 @@
 //!   additive sufficient statistics used for the clustering decisions ([`stats`]).
 //! * [`compare`]: the Hoover et al. protocol with `T = 0.8`, k-value and angle deviation
 //!   ([`hoover`]).
+//! * [`msac()`](fn@msac): the iterative MSAC baseline (module [`mod@msac`]).
 //! * [`PpeParams::synpeb`], [`PpeParams::segcomp`]: presets of the two benchmarks.
 //!
 //! Frames and units: the sensor frame (REP-103: x forward, y left, z up) with every ray
@@ -48,6 +49,7 @@
 pub mod error;
 pub mod fit;
 pub mod hoover;
+pub mod msac;
 pub mod params;
 pub mod ppe;
 pub mod stats;
@@ -56,6 +58,7 @@ pub mod tetromino;
 pub use error::PlaneError;
 pub use fit::{PlaneFit, fit_plane, radial_sse};
 pub use hoover::{HooverParams, HooverResult, compare};
+pub use msac::{MsacParams, msac};
 pub use params::PpeParams;
 pub use ppe::{Plane, Segmentation, extract, extract_grid};
 pub use stats::PlaneStats;
