@@ -95,7 +95,8 @@
 //! * [`motion::OdometryMotionModel`]: α1 = α2 = α3 = α4 = 0.2 (ROS AMCL).
 //! * [`init::GaussianInit`]: σ 1 m horizontal, 0.2 m vertical, 0.1 rad (thesis ch. 7).
 //! * [`eval::EvaluationConfig`]: spacing 1 m, divergence threshold 5 m.
-//! * [`lidar::LidarConfig`]: every beam, likelihood exponent γ = 8 / (kept beams);
+//! * [`lidar::LidarConfig`]: every beam, likelihood exponent γ = 8 / (kept beams), per-beam
+//!   random-measurement mixture ε = 0.05 (AMCL's `z_rand`; half no-return, half uniform return);
 //!   [`lidar::TrackConfig`]: 1000 particles, updates after 0.2 m / 0.2 rad.
 //!
 //! ## Performance
