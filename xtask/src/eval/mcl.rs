@@ -289,7 +289,7 @@ increments with the 6-DOF Gaussian noise model (`Gaussian6DofMotionModel::defaul
 unnormalized value; **(FMP)** = full map posterior (ch. 8).
 ";
 
-/// Thesis Table 7.2 (position error [m], DEC / REF / END, 300 particles, 3-D).
+/// Thesis Table 7.2 (position error in metres, DEC / REF / END, 300 particles, 3-D).
 const THESIS: [(&str, [f64; 3]); 4] = [
     ("campus", [0.230, 0.284, 0.280]),
     ("campus*", [0.252, 0.284, 0.366]),
