@@ -155,10 +155,9 @@
 //! cells) at 1.7 M rays/s; the simulated KITTI-layout drive `urban-kitti` (128.5 M points,
 //! 0.5 m voxels, `--max-range 60`) at 3.0 M rays/s. The mapping bench
 //! (`cargo bench -p raypath-sensor-models --bench mapping`: 48 sweeps of 20 000 rays of
-//! 20–60 m, 400 × 400 × 40 voxels; 2 000 scans of 180 beams of 1–30 m on 0.1 m cells), run
-//! while the machine had a load of about 5.5 on its 2 cores: 3-D dense 0.63 M rays/s
-//! (one thread 0.78 M), 3-D sparse 0.32 M, 2-D dense 0.53 M — criterion reported these
-//! 31–46 % below its previous run, so they are load-bound lower bounds; long rays cross
+//! 20–60 m, 400 × 400 × 40 voxels; 2 000 scans of 180 beams of 1–30 m on 0.1 m cells), on the
+//! otherwise idle 2-core machine (`-- --warm-up-time 1 --measurement-time 8`): 3-D dense
+//! 2.04 M rays/s on both cores (one thread 1.27 M), 3-D sparse 1.32 M; long rays cross
 //! ~100 voxels each, which is why the KITTI drive (mostly short ground returns) maps faster.
 
 mod dimension;
