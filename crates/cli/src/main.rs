@@ -54,6 +54,19 @@ enum Command {
     /// Score a segmentation against ground-truth labels (Hoover et al., T = 0.8): f, k and
     /// the over-, under-segmented, missed and noise counts.
     SegcompEval(commands::segcomp_eval::Args),
+    /// Build the Rtree variable-resolution occupancy grid (Khan ch. 2) from a scan graph or
+    /// sequence: nodes, leaves, bytes, times.
+    Octree(commands::octree::Args),
+    /// Pole extraction, pole maps and pole-based particle-filter localization (Schaefer ch. 12).
+    Poles(commands::poles::Args),
+    /// Fit a continuous DCT decay-rate map (Schaefer ch. 9) and a grid map with as many
+    /// parameters from the same rays, and score both.
+    DctMap(commands::dct_map::Args),
+    /// Hector-style scan matching of a CARMEN log with occupancy, reflectivity or combined
+    /// residuals (Khan ch. 3): trajectory, map, speed and errors.
+    ScanMatch(commands::scan_match::Args),
+    /// Fit the intensity look-up table I_ref(r, α) from reference-surface samples (Khan ch. 3).
+    CalibrateIntensity(commands::calibrate_intensity::Args),
 }
 
 fn main() -> ExitCode {
@@ -67,6 +80,11 @@ fn main() -> ExitCode {
         Command::Polylines(args) => commands::polylines::run(args),
         Command::Planes(args) => commands::planes::run(args),
         Command::SegcompEval(args) => commands::segcomp_eval::run(args),
+        Command::Octree(args) => commands::octree::run(args),
+        Command::Poles(args) => commands::poles::run(args),
+        Command::DctMap(args) => commands::dct_map::run(args),
+        Command::ScanMatch(args) => commands::scan_match::run(args),
+        Command::CalibrateIntensity(args) => commands::calibrate_intensity::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,10 +6,15 @@
 
 mod carmen_angles;
 mod corridor;
+mod dct;
 mod geometry;
 mod io;
 mod mcl;
+mod octomap;
+mod poles_kitti;
+mod poles_nclt;
 mod polylines;
+mod scan_matching;
 mod segcomp;
 mod sensor_models;
 mod sim;
@@ -121,6 +126,31 @@ const EVALUATIONS: &[(&str, &str, EvalFn)] = &[
         "segcomp",
         "PPE on the SegComp Perceptron scans when installed (Table 11.1); else how to get them",
         segcomp::run,
+    ),
+    (
+        "octomap",
+        "Rtree variable-resolution occupancy grid beside OctoMap measured in the same run (Khan ch. 2)",
+        octomap::run,
+    ),
+    (
+        "poles-kitti",
+        "pole extraction and pole-based localization on semi-synthetic KITTI drives (Table 12.2)",
+        poles_kitti::run,
+    ),
+    (
+        "poles-nclt",
+        "pole-based localization over simulated NCLT-style sessions (Table 12.1)",
+        poles_nclt::run,
+    ),
+    (
+        "dct",
+        "continuous DCT decay-rate maps against grid maps on the real logs (Tables 9.2-9.4)",
+        dct::run,
+    ),
+    (
+        "scan-matching",
+        "intensity calibration and Hector-style scan matching with occupancy/reflectivity residuals (Khan ch. 3)",
+        scan_matching::run,
     ),
 ];
 

@@ -1,10 +1,15 @@
 //! One module per subcommand, plus the shared failure type.
 
+pub mod calibrate_intensity;
+pub mod dct_map;
 pub mod info;
 pub mod localize;
 pub mod map;
+pub mod octree;
 pub mod planes;
+pub mod poles;
 pub mod polylines;
+pub mod scan_match;
 pub mod score_model;
 pub mod segcomp_eval;
 pub mod simulate;

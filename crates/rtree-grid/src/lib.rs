@@ -1,0 +1,3 @@
+//! Rtree variable-resolution occupancy grid (Khan 2017, ch. 2).
+//!
+//! Work in progress: the API lands with its issue.
