@@ -1,0 +1,174 @@
+//! Cell fusion, `Fuse(g_i)` of Khan 2017, Fig. 2.7, with the coverage and non-overlap
+//! checks of the spec's flagged rule (§2.F.4).
+
+use super::{RtreeGrid, SensorModel};
+use crate::key::KeyBox;
+
+/// One search direction: an axis and a sign.
+type Direction = (usize, bool);
+
+/// The search-direction order S̄_i (Eq. 2.8): cubes try +x, +y, +z, −x, −y, −z; other
+/// cuboids try ± of their longest axis first, then the second longest, then the shortest
+/// (ties: x before y before z, + before −).
+fn search_order(widths: [u32; 3]) -> [Direction; 6] {
+    if widths[0] == widths[1] && widths[1] == widths[2] {
+        return [
+            (0, true),
+            (1, true),
+            (2, true),
+            (0, false),
+            (1, false),
+            (2, false),
+        ];
+    }
+    let mut axes = [0usize, 1, 2];
+    axes.sort_by_key(|&a| std::cmp::Reverse(widths[a]));
+    [
+        (axes[0], true),
+        (axes[0], false),
+        (axes[1], true),
+        (axes[1], false),
+        (axes[2], true),
+        (axes[2], false),
+    ]
+}
+
+/// The slab `R̄_i \ R_i` of expanding `bx` by its own width along `direction`
+/// (`R̄_i = R_i +^j S̄_i`), or `None` past the lattice edge.
+fn slab(bx: &KeyBox, (axis, positive): Direction) -> Option<KeyBox> {
+    let w = i32::from(bx.hi[axis]) - i32::from(bx.lo[axis]) + 1;
+    let (lo, hi) = if positive {
+        (i32::from(bx.hi[axis]) + 1, i32::from(bx.hi[axis]) + w)
+    } else {
+        (i32::from(bx.lo[axis]) - w, i32::from(bx.lo[axis]) - 1)
+    };
+    let mut s = *bx;
+    s.lo[axis] = u16::try_from(lo).ok()?;
+    s.hi[axis] = u16::try_from(hi).ok()?;
+    Some(s)
+}
+
+impl RtreeGrid {
+    /// Runs `Fuse(g_i)` on cell `id` (repeating on the fused cell, the thesis' recursive
+    /// call); returns the number of fusion steps.
+    pub(super) fn fuse(&mut self, mut id: u32) -> usize {
+        let mut steps = 0;
+        let mut members: Vec<u32> = Vec::new();
+        loop {
+            let cell = self.cells[id as usize];
+            if cell.log_odds.is_nan() {
+                return steps; // removed earlier in this pass
+            }
+            let Some(occupied) = self.is_clamped(cell.log_odds) else {
+                return steps;
+            };
+            if !occupied && self.config.model == SensorModel::BeamEndPoint {
+                return steps; // §2.F.6: only occupied fusion
+            }
+            let mut fused = None;
+            for direction in search_order(cell.bx.widths()) {
+                let Some(slab) = slab(&cell.bx, direction) else {
+                    continue;
+                };
+                if self.slab_fuses(&slab, occupied, &mut members) {
+                    fused = Some(slab);
+                    break;
+                }
+            }
+            let Some(slab) = fused else {
+                return steps;
+            };
+            // The fused cell's probability is the mean of its cells' (equal weight per
+            // cell, g_i included); all are clamped to the same bound.
+            let mut sum = f64::from(cell.log_odds);
+            for &m in &members {
+                sum += f64::from(self.cells[m as usize].log_odds);
+            }
+            let mean = (sum / (members.len() + 1) as f64) as f32;
+            self.delete_cell(id);
+            for &m in &members {
+                self.delete_cell(m);
+            }
+            id = self.create_cell(cell.bx.union(&slab), mean);
+            steps += 1;
+        }
+    }
+
+    /// Whether the slab is exactly tiled by leaves lying completely inside it, all clamped
+    /// with polarity `occupied` (Eqs. 2.9–2.11 plus the coverage and containment checks);
+    /// fills `members` with them.
+    fn slab_fuses(&self, slab: &KeyBox, occupied: bool, members: &mut Vec<u32>) -> bool {
+        members.clear();
+        let mut ok = true;
+        let mut volume = 0u64;
+        let target = slab.volume();
+        if target == 1 {
+            // A single base cube: one index look-up.
+            return match self.index.get(slab.lo, Self::key_of_cell(&self.cells)) {
+                Some(id) if self.is_clamped(self.cells[id as usize].log_odds) == Some(occupied) => {
+                    members.push(id);
+                    true
+                }
+                _ => false,
+            };
+        }
+        self.tree.for_each_intersecting(slab, &mut |id, bx| {
+            if !ok {
+                return;
+            }
+            if !slab.contains_box(bx)
+                || self.is_clamped(self.cells[id as usize].log_odds) != Some(occupied)
+            {
+                ok = false;
+                return;
+            }
+            volume += bx.volume();
+            members.push(id);
+        });
+        ok && volume == target
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn order_prefers_the_long_axis() {
+        assert_eq!(
+            search_order([1, 1, 1])[..3],
+            [(0, true), (1, true), (2, true)]
+        );
+        assert_eq!(
+            search_order([1, 4, 2])[..3],
+            [(1, true), (1, false), (2, true)]
+        );
+    }
+
+    #[test]
+    fn slab_doubles_along_the_direction() {
+        let b = KeyBox {
+            lo: [10, 10, 10],
+            hi: [11, 10, 10],
+        };
+        assert_eq!(
+            slab(&b, (0, true)),
+            Some(KeyBox {
+                lo: [12, 10, 10],
+                hi: [13, 10, 10]
+            })
+        );
+        assert_eq!(
+            slab(&b, (1, false)),
+            Some(KeyBox {
+                lo: [10, 9, 10],
+                hi: [11, 9, 10]
+            })
+        );
+        let edge = KeyBox {
+            lo: [0, 0, 0],
+            hi: [0, 0, 0],
+        };
+        assert_eq!(slab(&edge, (0, false)), None);
+    }
+}

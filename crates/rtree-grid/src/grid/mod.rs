@@ -1,0 +1,466 @@
+//! The Rtree variable-resolution occupancy grid (Khan 2017, §2.5).
+
+mod fuse;
+mod query;
+mod ray;
+#[cfg(test)]
+mod tests;
+
+use nalgebra::Point3;
+use raypath_geometry::{PointCloud, Pose3};
+
+use crate::config::{GridConfig, Selection, SensorModel, logit};
+use crate::index::LatticeIndex;
+use crate::key::{Key, KeyBox, key_of, pack, unpack};
+use crate::rtree::{OrderError, RTree};
+
+pub use query::{Cuboid, Occupancy};
+
+/// A leaf cell: its box of base cubes and its log-odds (16 bytes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Cell {
+    bx: KeyBox,
+    log_odds: f32,
+}
+
+/// Errors of the grid.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GridError {
+    /// The R-tree order is invalid.
+    #[error(transparent)]
+    Order(#[from] OrderError),
+    /// A parameter is out of range.
+    #[error("invalid grid parameter: {0}")]
+    Parameter(String),
+}
+
+/// What one [`RtreeGrid::insert_scan`] did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ScanUpdate {
+    /// Beams used (finite end points on the lattice).
+    pub beams: usize,
+    /// Distinct base cubes updated as free.
+    pub free_keys: usize,
+    /// Distinct base cubes updated as occupied.
+    pub occupied_keys: usize,
+    /// Cells created.
+    pub created: usize,
+    /// Successful fusion steps.
+    pub fusions: usize,
+    /// Fused cells split back into base cubes.
+    pub splits: usize,
+}
+
+/// Sizes of the map.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct GridStats {
+    /// Leaf cells (cubes and fused cuboids).
+    pub leaves: usize,
+    /// Leaves with probability above the occupancy threshold.
+    pub occupied_leaves: usize,
+    /// Fused leaves (more than one base cube).
+    pub fused_leaves: usize,
+    /// R-tree nodes (the MBRCs of the hierarchy, root included).
+    pub nodes: usize,
+    /// R-tree height.
+    pub height: usize,
+    /// Base cubes covered by leaves (the volume in units of r³).
+    pub base_cubes: u64,
+    /// Bytes allocated by the map (tree arena, cells, lattice index).
+    pub bytes: usize,
+}
+
+/// The Rtree variable-resolution occupancy grid: leaf cells are lattice-aligned cuboids in
+/// an [`RTree`], updated with log-odds (Eq. 2.7) and fused after each scan (§2.5.2).
+#[derive(Clone, Debug)]
+pub struct RtreeGrid {
+    config: GridConfig,
+    tree: RTree,
+    cells: Vec<Cell>,
+    free_cells: Vec<u32>,
+    index: LatticeIndex,
+    fused_cells: usize,
+    l_hit: f32,
+    l_miss: f32,
+    l_min: f32,
+    l_max: f32,
+    l_threshold: f32,
+    scans: u64,
+    free_keys: Vec<u64>,
+    occupied_keys: Vec<u64>,
+    sample_keys: Vec<u64>,
+    touched_fused: Vec<(u32, bool)>,
+    selected: Vec<u32>,
+}
+
+/// Slack when comparing a log-odds with a clamping bound.
+const CLAMP_EPS: f32 = 1e-4;
+
+impl RtreeGrid {
+    /// An empty grid.
+    pub fn new(config: GridConfig) -> Result<Self, GridError> {
+        let bad = |what: &str| Err(GridError::Parameter(what.to_owned()));
+        if !(config.resolution_m.is_finite() && config.resolution_m > 0.0) {
+            return bad("resolution must be positive and finite");
+        }
+        let probs = [
+            config.prob_hit,
+            config.prob_miss,
+            config.clamp_min,
+            config.clamp_max,
+            config.occupancy_threshold,
+        ];
+        if !probs.iter().all(|p| *p > 0.0 && *p < 1.0) {
+            return bad("probabilities must lie in (0, 1)");
+        }
+        if !(config.clamp_min < 0.5 && config.clamp_max > 0.5) {
+            return bad("clamping bounds must enclose 0.5");
+        }
+        if !(config.prob_hit > 0.5 && config.prob_miss < 0.5) {
+            return bad("P_occ must exceed 0.5 and P_free lie below 0.5");
+        }
+        if let Some(r) = config.max_range_m {
+            if r.is_nan() || r <= 0.0 {
+                return bad("max range must be positive");
+            }
+        }
+        if let Selection::BeamSamples { spacing_cells } = config.selection {
+            if !(spacing_cells >= 1.0 && spacing_cells.is_finite()) {
+                return bad("sample spacing must be at least one cell");
+            }
+        }
+        let tree = RTree::new(config.min_entries, config.max_entries)?;
+        Ok(Self {
+            config,
+            tree,
+            cells: Vec::new(),
+            free_cells: Vec::new(),
+            index: LatticeIndex::default(),
+            fused_cells: 0,
+            l_hit: logit(config.prob_hit) as f32,
+            l_miss: logit(config.prob_miss) as f32,
+            l_min: logit(config.clamp_min) as f32,
+            l_max: logit(config.clamp_max) as f32,
+            l_threshold: logit(config.occupancy_threshold) as f32,
+            scans: 0,
+            free_keys: Vec::new(),
+            occupied_keys: Vec::new(),
+            sample_keys: Vec::new(),
+            touched_fused: Vec::new(),
+            selected: Vec::new(),
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &GridConfig {
+        &self.config
+    }
+
+    /// The R-tree of the leaf cells (read-only).
+    pub fn tree(&self) -> &RTree {
+        &self.tree
+    }
+
+    /// Number of scans inserted.
+    pub fn scans(&self) -> u64 {
+        self.scans
+    }
+
+    /// Number of leaf cells.
+    pub fn num_leaves(&self) -> usize {
+        self.tree.len()
+    }
+
+    #[inline]
+    fn key_of_cell(cells: &[Cell]) -> impl Fn(u32) -> Key + '_ {
+        move |id| cells[id as usize].bx.lo
+    }
+
+    /// Inserts one scan of a sensor at `world_from_sensor` with points in the sensor frame;
+    /// invalid (NaN) points are skipped.
+    pub fn insert_cloud(&mut self, world_from_sensor: &Pose3, cloud: &PointCloud) -> ScanUpdate {
+        let origin = world_from_sensor.translation();
+        let points: Vec<Point3<f64>> = (0..cloud.len())
+            .filter(|&i| cloud.is_valid(i))
+            .map(|i| world_from_sensor.transform_point(&cloud.point_f64(i)))
+            .collect();
+        self.insert_scan(&Point3::from(origin), &points)
+    }
+
+    /// Inserts one scan: beams from `origin_m` to each end point (world frame, metres).
+    /// Updates every touched cell once (occupied wins over free), then fuses (§2.5.3).
+    pub fn insert_scan(&mut self, origin_m: &Point3<f64>, points_m: &[Point3<f64>]) -> ScanUpdate {
+        let mut update = ScanUpdate::default();
+        let r = self.config.resolution_m;
+        let origin = [origin_m.x, origin_m.y, origin_m.z];
+        let beam = self.config.model == SensorModel::BeamBased;
+        let spacing = match self.config.selection {
+            Selection::BeamSamples { spacing_cells } if beam && self.config.fusion => {
+                Some(spacing_cells * r)
+            }
+            _ => None,
+        };
+        let mut free_keys = std::mem::take(&mut self.free_keys);
+        let mut occupied_keys = std::mem::take(&mut self.occupied_keys);
+        let mut sample_keys = std::mem::take(&mut self.sample_keys);
+        free_keys.clear();
+        occupied_keys.clear();
+        sample_keys.clear();
+        let mut rng = ray::SplitMix(self.config.seed ^ self.scans.wrapping_mul(0x9E37_79B9));
+        for p in points_m {
+            let mut end = [p.x, p.y, p.z];
+            if !end.iter().all(|v| v.is_finite()) {
+                continue;
+            }
+            let d = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
+            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            let mut hit = true;
+            if let Some(max) = self.config.max_range_m {
+                if len > max {
+                    let s = max / len;
+                    end = [
+                        origin[0] + d[0] * s,
+                        origin[1] + d[1] * s,
+                        origin[2] + d[2] * s,
+                    ];
+                    hit = false;
+                }
+            }
+            update.beams += 1;
+            if hit {
+                if let Some(k) = key_of(end, r) {
+                    occupied_keys.push(pack(k));
+                }
+            }
+            if beam {
+                ray::ray_keys(origin, end, r, &mut free_keys);
+                if let Some(spacing) = spacing {
+                    let n = (len.min(self.config.max_range_m.unwrap_or(f64::INFINITY)) / spacing)
+                        .ceil() as usize;
+                    for _ in 0..n {
+                        let t = rng.next_f64();
+                        let q = [
+                            origin[0] + (end[0] - origin[0]) * t,
+                            origin[1] + (end[1] - origin[1]) * t,
+                            origin[2] + (end[2] - origin[2]) * t,
+                        ];
+                        if let Some(k) = key_of(q, r) {
+                            sample_keys.push(pack(k));
+                        }
+                    }
+                }
+            }
+        }
+        occupied_keys.sort_unstable();
+        occupied_keys.dedup();
+        free_keys.sort_unstable();
+        free_keys.dedup();
+        // Occupied wins: drop free keys that are also hit (both lists are sorted).
+        {
+            let mut j = 0;
+            free_keys.retain(|k| {
+                while j < occupied_keys.len() && occupied_keys[j] < *k {
+                    j += 1;
+                }
+                !(j < occupied_keys.len() && occupied_keys[j] == *k)
+            });
+        }
+        update.free_keys = free_keys.len();
+        update.occupied_keys = occupied_keys.len();
+        let mut selected = std::mem::take(&mut self.selected);
+        selected.clear();
+        let collect_all = matches!(self.config.selection, Selection::UpdatedCells);
+        for (keys, hit) in [(&free_keys, false), (&occupied_keys, true)] {
+            for &packed in keys.iter() {
+                let id = self.update_key(unpack(packed), hit, &mut update);
+                if collect_all || hit {
+                    if let Some(id) = id {
+                        selected.push(id);
+                    }
+                }
+            }
+        }
+        self.apply_fused_updates();
+        if self.config.fusion {
+            for &packed in &sample_keys {
+                if let Some(id) = self.cell_id_of_key(unpack(packed)) {
+                    selected.push(id);
+                }
+            }
+            selected.sort_unstable();
+            selected.dedup();
+            for &id in &selected {
+                update.fusions += self.fuse(id);
+            }
+        }
+        self.scans += 1;
+        self.free_keys = free_keys;
+        self.occupied_keys = occupied_keys;
+        self.sample_keys = sample_keys;
+        self.selected = selected;
+        update
+    }
+
+    /// The id of the cell containing base cube `key`.
+    fn cell_id_of_key(&self, key: Key) -> Option<u32> {
+        if let Some(id) = self.index.get(key, Self::key_of_cell(&self.cells)) {
+            return Some(id);
+        }
+        if self.fused_cells == 0 {
+            return None;
+        }
+        self.tree.find_containing(key).map(|(id, _)| id)
+    }
+
+    #[inline]
+    fn updated(&self, log_odds: f32, hit: bool) -> f32 {
+        let delta = if hit { self.l_hit } else { self.l_miss };
+        (log_odds + delta).clamp(self.l_min, self.l_max) // Eq. (2.7), clamped
+    }
+
+    /// Applies one update to the cell holding `key` (creating it); returns the cell id for
+    /// base cubes, `None` for a fused cell (queued, updated once per scan).
+    fn update_key(&mut self, key: Key, hit: bool, update: &mut ScanUpdate) -> Option<u32> {
+        if let Some(id) = self.index.get(key, Self::key_of_cell(&self.cells)) {
+            let l = self.cells[id as usize].log_odds;
+            self.cells[id as usize].log_odds = self.updated(l, hit);
+            return Some(id);
+        }
+        if self.fused_cells > 0 {
+            if let Some((id, bx)) = self.tree.find_containing(key) {
+                let l = self.cells[id as usize].log_odds;
+                let leaves_clamp = self.is_clamped(l).is_some()
+                    && self.is_clamped(self.updated(l, hit)) != self.is_clamped(l);
+                if self.config.split_on_unclamp && leaves_clamp && bx.volume() <= MAX_SPLIT {
+                    self.split_cell(id);
+                    update.splits += 1;
+                    return self.update_key(key, hit, update);
+                }
+                self.touched_fused.push((id, hit));
+                return None;
+            }
+        }
+        let l = self.updated(0.0, hit);
+        let id = self.create_cell(KeyBox::cube(key), l);
+        update.created += 1;
+        Some(id)
+    }
+
+    /// Updates every fused cell touched this scan once; occupied wins.
+    fn apply_fused_updates(&mut self) {
+        let mut touched = std::mem::take(&mut self.touched_fused);
+        // Sort by id, hits last, so the last entry per id is the winning one.
+        touched.sort_unstable();
+        for (i, &(id, hit)) in touched.iter().enumerate() {
+            if touched.get(i + 1).is_some_and(|next| next.0 == id) {
+                continue;
+            }
+            let l = self.cells[id as usize].log_odds;
+            if !l.is_nan() {
+                self.cells[id as usize].log_odds = self.updated(l, hit);
+            }
+        }
+        touched.clear();
+        self.touched_fused = touched;
+    }
+
+    /// `Some(true)` when clamped occupied, `Some(false)` when clamped free.
+    #[inline]
+    fn is_clamped(&self, log_odds: f32) -> Option<bool> {
+        if log_odds >= self.l_max - CLAMP_EPS {
+            Some(true)
+        } else if log_odds <= self.l_min + CLAMP_EPS {
+            Some(false)
+        } else {
+            None
+        }
+    }
+
+    fn create_cell(&mut self, bx: KeyBox, log_odds: f32) -> u32 {
+        let cell = Cell { bx, log_odds };
+        let id = if let Some(id) = self.free_cells.pop() {
+            self.cells[id as usize] = cell;
+            id
+        } else {
+            self.cells.push(cell);
+            (self.cells.len() - 1) as u32
+        };
+        if bx.volume() == 1 {
+            self.index.insert(bx.lo, id, Self::key_of_cell(&self.cells));
+        } else {
+            self.fused_cells += 1;
+        }
+        self.tree.insert(id, bx);
+        id
+    }
+
+    fn delete_cell(&mut self, id: u32) -> Cell {
+        let cell = self.cells[id as usize];
+        if cell.bx.volume() == 1 {
+            self.index
+                .remove(cell.bx.lo, Self::key_of_cell(&self.cells));
+        } else {
+            self.fused_cells -= 1;
+        }
+        self.tree.remove(id, &cell.bx);
+        self.cells[id as usize].log_odds = f32::NAN;
+        self.free_cells.push(id);
+        cell
+    }
+
+    /// Replaces fused cell `id` by base cubes carrying its log-odds.
+    fn split_cell(&mut self, id: u32) {
+        let cell = self.delete_cell(id);
+        let (lo, hi) = (cell.bx.lo, cell.bx.hi);
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    self.create_cell(KeyBox::cube([x, y, z]), cell.log_odds);
+                }
+            }
+        }
+    }
+
+    /// Sizes of the map.
+    pub fn stats(&self) -> GridStats {
+        let mut stats = GridStats {
+            leaves: self.tree.len(),
+            nodes: self.tree.num_nodes(),
+            height: self.tree.height(),
+            fused_leaves: self.fused_cells,
+            bytes: self.memory_bytes(),
+            ..GridStats::default()
+        };
+        self.tree.for_each_item(&mut |id, bx| {
+            stats.base_cubes += bx.volume();
+            if self.cells[id as usize].log_odds > self.l_threshold {
+                stats.occupied_leaves += 1;
+            }
+        });
+        stats
+    }
+
+    /// Bytes allocated by the map: the tree arena, the cell arena (16 B per cell), the free
+    /// list and the lattice index (excluding per-scan scratch vectors).
+    pub fn memory_bytes(&self) -> usize {
+        self.tree.memory_bytes()
+            + self.cells.capacity() * size_of::<Cell>()
+            + self.free_cells.capacity() * 4
+            + self.index.memory_bytes()
+            + size_of::<Self>()
+    }
+
+    /// Releases spare capacity (per-scan scratch and vector slack).
+    pub fn shrink_to_fit(&mut self) {
+        self.cells.shrink_to_fit();
+        self.free_cells.shrink_to_fit();
+        self.free_keys = Vec::new();
+        self.occupied_keys = Vec::new();
+        self.sample_keys = Vec::new();
+        self.selected = Vec::new();
+        self.touched_fused = Vec::new();
+    }
+}
+
+/// Largest fused cell (in base cubes) that is split back when it leaves the clamped state.
+const MAX_SPLIT: u64 = 1 << 16;

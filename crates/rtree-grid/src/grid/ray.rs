@@ -1,0 +1,121 @@
+//! Beam traversal of the global lattice and the beam sampler.
+//!
+//! [`ray_keys`] is the exact voxel traversal of Amanatides & Woo (1987) on the unbounded
+//! 16-bit lattice, with OctoMap's conventions (`computeRayKeys`): the keys of every base
+//! cube the segment crosses, starting with the origin's cube and excluding the end point's
+//! cube, stopping early when accumulated rounding would step past the end. (raypath-geometry's
+//! traversal works on bounded `Grid3`s; the grid here has no bounds, so the same stepping
+//! runs on integer keys.)
+
+use crate::key::{KEY_OFFSET, key_of, pack};
+
+/// Appends the packed keys of the cubes the segment `origin → end` crosses before the cube
+/// of `end`.
+pub(crate) fn ray_keys(origin: [f64; 3], end: [f64; 3], resolution_m: f64, out: &mut Vec<u64>) {
+    let (Some(start), Some(stop)) = (key_of(origin, resolution_m), key_of(end, resolution_m))
+    else {
+        return;
+    };
+    if start == stop {
+        return;
+    }
+    let d = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
+    let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let mut step = [0i32; 3];
+    let mut t_max = [f64::INFINITY; 3];
+    let mut t_delta = [f64::INFINITY; 3];
+    let mut current = [
+        i32::from(start[0]),
+        i32::from(start[1]),
+        i32::from(start[2]),
+    ];
+    let target = [i32::from(stop[0]), i32::from(stop[1]), i32::from(stop[2])];
+    for a in 0..3 {
+        let dir = d[a] / length;
+        if dir > 0.0 {
+            step[a] = 1;
+        } else if dir < 0.0 {
+            step[a] = -1;
+        }
+        if step[a] != 0 {
+            let mut border = (i64::from(current[a]) - KEY_OFFSET) as f64 * resolution_m;
+            if step[a] > 0 {
+                border += resolution_m;
+            }
+            t_max[a] = (border - origin[a]) / dir;
+            t_delta[a] = resolution_m / dir.abs();
+        }
+    }
+    let max_steps: i32 = (0..3).map(|a| (target[a] - current[a]).abs()).sum::<i32>() + 3;
+    out.push(pack(start));
+    for _ in 0..max_steps {
+        let a = if t_max[0] < t_max[1] {
+            if t_max[0] < t_max[2] { 0 } else { 2 }
+        } else if t_max[1] < t_max[2] {
+            1
+        } else {
+            2
+        };
+        current[a] += step[a];
+        t_max[a] += t_delta[a];
+        if current == target {
+            return;
+        }
+        let dist = t_max[0].min(t_max[1]).min(t_max[2]);
+        if dist > length || !(0..=65535).contains(&current[a]) {
+            return;
+        }
+        out.push(pack(current.map(|c| c as u16)));
+    }
+}
+
+/// SplitMix64, a tiny seeded generator for the beam samples.
+pub(crate) struct SplitMix(pub u64);
+
+impl SplitMix {
+    /// Next value in `[0, 1)`.
+    #[inline]
+    pub(crate) fn next_f64(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::key::unpack;
+
+    #[test]
+    fn axis_ray_crosses_every_cube_before_the_end() {
+        let mut out = Vec::new();
+        ray_keys([0.05, 0.05, 0.05], [0.55, 0.05, 0.05], 0.1, &mut out);
+        let xs: Vec<u16> = out.iter().map(|&k| unpack(k)[0]).collect();
+        assert_eq!(xs, vec![32768, 32769, 32770, 32771, 32772]);
+    }
+
+    #[test]
+    fn diagonal_ray_steps_face_neighbours() {
+        let mut out = Vec::new();
+        ray_keys([0.01, 0.02, 0.03], [-1.37, 2.11, 0.77], 0.1, &mut out);
+        let end = key_of([-1.37, 2.11, 0.77], 0.1).unwrap();
+        assert!(!out.contains(&pack(end)));
+        for w in out.windows(2) {
+            let (a, b) = (unpack(w[0]), unpack(w[1]));
+            let diff: i32 = (0..3)
+                .map(|i| (i32::from(a[i]) - i32::from(b[i])).abs())
+                .sum();
+            assert_eq!(diff, 1);
+        }
+        // The last cube is a face neighbour of the end cube.
+        let last = unpack(*out.last().unwrap());
+        let diff: i32 = (0..3)
+            .map(|i| (i32::from(last[i]) - i32::from(end[i])).abs())
+            .sum();
+        assert_eq!(diff, 1);
+    }
+}

@@ -1,0 +1,81 @@
+use proptest::prelude::*;
+
+use super::*;
+
+fn cube(x: u16, y: u16, z: u16) -> KeyBox {
+    KeyBox::cube([x, y, z])
+}
+
+#[test]
+fn rejects_bad_orders() {
+    assert!(RTree::new(0, 8).is_err());
+    assert!(RTree::new(5, 8).is_err());
+    assert!(RTree::new(1, 1).is_err());
+    assert!(RTree::new(2, 4).is_ok());
+}
+
+#[test]
+fn thesis_example_m2_splits_and_grows() {
+    // Fig. 2.3: with M = 2, inserting A..D makes the tree grow to height 2+.
+    let mut tree = RTree::new(1, 2).unwrap();
+    for (i, b) in [cube(0, 0, 0), cube(1, 0, 0), cube(5, 5, 0), cube(6, 5, 0)]
+        .iter()
+        .enumerate()
+    {
+        tree.insert(i as u32, *b);
+        tree.check_invariants().unwrap();
+    }
+    assert!(tree.height() >= 2);
+    assert_eq!(tree.find_containing([5, 5, 0]).map(|f| f.0), Some(2));
+    assert_eq!(tree.find_containing([3, 3, 3]), None);
+    // With M = 4 one node holds all four.
+    let mut wide = RTree::new(2, 4).unwrap();
+    for i in 0..4u16 {
+        wide.insert(u32::from(i), cube(i, 0, 0));
+    }
+    assert_eq!((wide.height(), wide.num_nodes()), (1, 1));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn invariants_hold_under_inserts_and_removes(
+        order in prop::sample::select(vec![(1usize, 2usize), (2, 4), (3, 8), (4, 16), (6, 16)]),
+        cells in prop::collection::btree_set((0u16..12, 0u16..12, 0u16..4), 1..300),
+        remove_mask in prop::collection::vec(any::<bool>(), 300),
+    ) {
+        let (d, m) = order;
+        let mut tree = RTree::new(d, m).unwrap();
+        let cells: Vec<_> = cells.into_iter().collect();
+        for (i, &(x, y, z)) in cells.iter().enumerate() {
+            tree.insert(i as u32, cube(x, y, z));
+        }
+        tree.check_invariants().map_err(TestCaseError::fail)?;
+        prop_assert_eq!(tree.len(), cells.len());
+        let mut kept = Vec::new();
+        for (i, &(x, y, z)) in cells.iter().enumerate() {
+            if remove_mask[i] {
+                prop_assert!(tree.remove(i as u32, &cube(x, y, z)));
+                tree.check_invariants().map_err(TestCaseError::fail)?;
+            } else {
+                kept.push((i as u32, cube(x, y, z)));
+            }
+        }
+        prop_assert_eq!(tree.len(), kept.len());
+        for &(id, b) in &kept {
+            prop_assert_eq!(tree.find_containing(b.lo), Some((id, b)));
+        }
+        let query = KeyBox { lo: [2, 3, 0], hi: [7, 9, 2] };
+        let mut found = Vec::new();
+        tree.for_each_intersecting(&query, &mut |id, _| found.push(id));
+        found.sort_unstable();
+        let mut expected: Vec<u32> =
+            kept.iter().filter(|(_, b)| b.intersects(&query)).map(|&(id, _)| id).collect();
+        expected.sort_unstable();
+        prop_assert_eq!(found, expected);
+        let mut all = 0;
+        tree.for_each_item(&mut |_, _| all += 1);
+        prop_assert_eq!(all, kept.len());
+    }
+}
