@@ -1,3 +1,109 @@
-//! Continuous decay-rate maps in the cosine domain (Schaefer 2020, ch. 9).
+//! # raypath-dct-map
 //!
-//! Work in progress: the API lands with its issue.
+//! Continuous decay-rate maps in the cosine domain — **DCT maps** — after Schaefer (2020),
+//! *Lidar mapping and localization*, **ch. 9** ("DCT Maps: Compact Differentiable Lidar Maps
+//! Based on the Cosine Transform"); equations are numbered as in the thesis and in the
+//! raypath spec `schaefer-2020-maps.md` §5.
+//!
+//! ## The idea
+//!
+//! A decay-rate map (ch. 7) says how often a laser ray is reflected per metre, `λ(x, y)`.
+//! Instead of one `λ` per grid cell, a DCT map stores `L × M` cosine amplitudes `a_lm` (as
+//! JPEG does) and evaluates the **continuous extension of the inverse DCT**, squared so that
+//! the rate is never negative (Eq. 9.6):
+//!
+//! ```text
+//! λ(x, y) = ( Σ_lm a_lm cos(l π x / X) cos(m π y / Y) )².
+//! ```
+//!
+//! Along a ray `s + v t` the optical depth `𝒮 = ∫ λ dt` has a closed form (Eq. 9.9–9.10), so
+//! a ray's likelihood — `λ(r) e^{−𝒮(r)}` for a return, `1 − e^{−𝒮(r_min)}` for `sub`,
+//! `e^{−𝒮}` for `super` (Eq. 9.5, 9.11, 9.12) — comes straight from the coefficients, with
+//! no rasterization. The map is the maximum-likelihood coefficient set, found by Newton's
+//! method with analytic derivatives (Sec. 9.4.4).
+//!
+//! ## Making it fast (exact rearrangements, not approximations)
+//!
+//! * `λ = g²` is itself a cosine series with `(2L − 1)(2M − 1)` terms whose coefficients are
+//!   the **self-convolution** `b_pq` of `a` ([`self_convolution`]), so a ray integral is
+//!   `Σ_pq b_pq T_pq` with closed-form moments `T_pq` ([`moments`]): about `4 I` terms per
+//!   ray instead of the `8 I²` of Eq. (9.10) (kept in [`reference`] for the tests).
+//! * In a fit every hit and `super` ray enters the likelihood through `−𝒮` with weight one,
+//!   so the integral part of the whole data set is `−aᵀ K a` with one Gram matrix `K` of the
+//!   summed moments, built once; the hit Hessians `−2 φφᵀ/g²` sum to the same kind of matrix
+//!   ([`FitProblem`]). An iteration costs `O(K · I + I²)` plus one dense Cholesky (`faer`).
+//!
+//! ## Example
+//!
+//! ```
+//! use raypath_dct_map::{DctMap, FitConfig, FitProblem, MapRay, Outcome, Shape, fit, initial_map};
+//!
+//! // A 4 m × 4 m room, a wall at x = 3 m; rays from (0.5, y) along +x hit it.
+//! let extent = [4.0, 4.0];
+//! let rays: Vec<MapRay> = (0..40)
+//!     .map(|k| MapRay::from_angle([0.5, 0.05 + 0.1 * k as f64], 0.0, 2.5 + 0.01 * (k % 3) as f64, Outcome::Hit))
+//!     .collect();
+//! let shape = Shape { l: 6, m: 3 };
+//! let start = initial_map(extent, shape, &rays)?;
+//! let problem = FitProblem::new(extent, shape, &rays)?;
+//! let (map, report) = fit(&problem, start.coefficients(), &FitConfig::default())?;
+//! assert!(report.log_likelihood() >= report.log_likelihoods[0]);
+//! // The wall reflects, the free space in front of it does not.
+//! assert!(map.rate_at([3.0, 2.0]) > 5.0 * map.rate_at([1.5, 2.0]));
+//! # Ok::<(), raypath_dct_map::DctError>(())
+//! ```
+//!
+//! ## Map of the crate
+//!
+//! | item | what |
+//! |---|---|
+//! | [`DctMap`] | coefficients, `λ` at a point in `O(I)`, on a lattice, optical depth, ray log-likelihood |
+//! | [`MapRay`], [`Outcome`], [`Patch`], [`RangeLimits`] | rays in the map frame; clipping world rays to a patch |
+//! | [`FitProblem`], [`fit`], [`FitConfig`], [`Solver`], [`FitReport`] | ML fit (trust-region Newton or L-BFGS) |
+//! | [`derivatives`] | per-ray gradient and Hessian in the thesis's `B`/`C` notation |
+//! | [`GridRateMap`], [`initial_map`], [`DctMap::from_grid`], [`DctMap::to_rate_grid`] | the grid baseline (ch. 7) and conversions |
+//! | [`render`] | PNG of `p_ref = 1 − e^{−λ}` |
+//!
+//! ## Defaults and where they come from
+//!
+//! | setting | default | source |
+//! |---|---|---|
+//! | [`FitConfig::relative_tolerance`] | `1e-3` | Sec. 9.5.3 |
+//! | [`FitConfig::solver`] | trust-region Newton | thesis names trust-region methods; measured faster than L-BFGS at equal likelihood (`docs/results/dct.md`) |
+//! | initialization | grid decay-rate map with `L × M` cells, `√λ` transformed | thesis silent; never `𝒜 = 0` (a saddle) |
+//! | [`RangeLimits`] | `r_min = 0`, `r_max = ∞` | CARMEN logs have no `sub` readings; no-returns are decoded by the reader |
+//!
+//! ## Errata and decisions
+//!
+//! * **Eq. (9.7)** lacks the `cos` around its argument; implemented with it (factor `1/8`).
+//! * **`sub` Hessian** (Sec. 9.4.4): the printed `+ 𝒩² C_i C_j/(1 − 𝒩)²` must be `−`; see
+//!   [`derivatives`], whose test shows the printed form failing finite differences.
+//! * `C_i = ⅛ Σ_j a_j Σ A_ij + A_ji` is read as `Σ (A_ij + A_ji)`.
+//! * Map frame: `x̃ = π x / X` with `x` measured from the patch's lower-left corner.
+//! * Rays are clipped to the patch ([`ray`] module docs): the likelihood is conditioned on a
+//!   ray reaching the patch, and rays crossing it without a return are `super` rays whose
+//!   `r_max` is the exit point.
+
+#![warn(missing_docs)]
+
+pub mod derivatives;
+mod error;
+mod fit;
+mod grid;
+mod map;
+pub mod moments;
+mod objective;
+pub mod ray;
+pub mod reference;
+pub mod render;
+mod spectrum;
+
+pub use error::DctError;
+pub use fit::{FitConfig, FitReport, Solver, fit};
+pub use grid::{GridRateMap, initial_map};
+pub use map::DctMap;
+pub use objective::{Evaluation, FitProblem};
+pub use ray::{MapRay, Outcome, Patch, RangeLimits};
+pub use spectrum::{
+    Shape, fill_product_matrix, product_matrix, product_matrix_times, self_convolution,
+};
