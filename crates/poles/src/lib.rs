@@ -1,3 +1,27 @@
 //! Pole extraction, pole maps and pole-based localization (Schaefer 2020, ch. 12).
 //!
-//! Work in progress: the API lands with its issue.
+//! Docs: see below.
+
+mod beta;
+mod error;
+mod extract;
+mod filters;
+mod hitmiss;
+mod localize;
+mod mapping;
+mod params;
+mod pole;
+mod score;
+
+pub use beta::{ReflectionPrior, ln_gamma, regularized_incomplete_beta};
+pub use error::{PoleError, Result};
+pub use extract::{
+    ExtractionStats, extract_poles, local_grid, non_maximum_suppression, occupancy,
+    poles_from_counts,
+};
+pub use hitmiss::HitMissGrid;
+pub use localize::{FilterParams, PoleFilter, PoleIndex};
+pub use mapping::{Segment, SlidingWindowFilter, merge_poles, overlap_clusters, segments};
+pub use params::PoleParams;
+pub use pole::Pole;
+pub use score::{ScoreVolume, pole_scores};

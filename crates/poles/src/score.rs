@@ -1,0 +1,179 @@
+//! Pole scores per voxel (spec §3.1): for every footprint width `a` and every voxel `j`, the
+//! best placement of an `a × a` footprint containing `j` of (mean occupancy inside) − (max
+//! occupancy of the free hull of thickness `f` around it), remapped to `[0, 1]`.
+
+use rayon::prelude::*;
+
+use crate::filters::{Scratch, box_sum, rect_max, summed_area};
+
+/// Pole scores of a local map.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScoreVolume {
+    /// Dimensions `(nx, ny, nz)`.
+    pub dims: [usize; 3],
+    /// Number of widths scored (`a = 1..=widths`).
+    pub widths: usize,
+    /// `Q = max_a q'_a` per voxel (linear index, x fastest), in `[0, 1]`.
+    pub best: Vec<f32>,
+    /// `q'_a` per width and voxel, quantized to `u8` (`q' ≈ v / 255`), width-major:
+    /// `per_width[(a − 1) · n + j]`.
+    pub per_width: Vec<u8>,
+}
+
+impl ScoreVolume {
+    /// `q'_a` of voxel `index` (`a` from 1).
+    #[inline]
+    pub fn width_score(&self, a: usize, index: usize) -> f32 {
+        let n = self.best.len();
+        self.per_width
+            .get((a - 1) * n + index)
+            .map_or(0.0, |&v| v as f32 / 255.0)
+    }
+}
+
+/// Computes the scores of an occupancy volume (`occupancy` per voxel, x fastest) with widths
+/// `1..=widths` and hull thickness `hull` cells. Slices are scored in parallel.
+pub fn pole_scores(occupancy: &[f32], dims: [usize; 3], widths: usize, hull: usize) -> ScoreVolume {
+    let [nx, ny, nz] = dims;
+    let n_slice = nx * ny;
+    let n = n_slice * nz;
+    let mut best = vec![0.0f32; n];
+    let mut per_width = vec![0u8; widths * n];
+    // Slice-major work: each task fills the best scores and its own per-width bytes.
+    let mut width_slices: Vec<Vec<&mut [u8]>> = (0..nz).map(|_| Vec::new()).collect();
+    for chunk in per_width.chunks_mut(n) {
+        for (z, slice) in chunk.chunks_mut(n_slice).enumerate() {
+            if let Some(list) = width_slices.get_mut(z) {
+                list.push(slice);
+            }
+        }
+    }
+    best.par_chunks_mut(n_slice)
+        .zip(occupancy.par_chunks(n_slice))
+        .zip(width_slices.into_par_iter())
+        .for_each_init(SliceWork::default, |work, ((best, occ), mut per_a)| {
+            work.score_slice(occ, nx, ny, widths, hull, best, &mut per_a);
+        });
+    ScoreVolume {
+        dims,
+        widths,
+        best,
+        per_width,
+    }
+}
+
+#[derive(Default)]
+struct SliceWork {
+    scratch: Scratch,
+    table: Vec<f64>,
+    /// Max over `f` rows upwards: `max_{dy<f} o(x, y + dy)`.
+    rows_f: Vec<f32>,
+    /// Max over `f` columns rightwards: `max_{dx<f} o(x + dx, y)`.
+    cols_f: Vec<f32>,
+    /// `max_{dx<span} rows_f(x + dx, y)`: the horizontal hull strips, grown with the span.
+    strip_h: Vec<f32>,
+    /// `max_{dy<span} cols_f(x, y + dy)`: the vertical hull strips, grown with the span.
+    strip_v: Vec<f32>,
+    raw: Vec<f32>,
+    q: Vec<f32>,
+}
+
+/// `acc(i) = max(acc(i), src(i + shift))` where `i + shift` is inside (a running window
+/// maximum grown by one element; entries whose window leaves the slice are never read).
+#[inline]
+fn grow(acc: &mut [f32], src: &[f32], shift: usize) {
+    if shift >= src.len() {
+        return;
+    }
+    for (a, s) in acc.iter_mut().zip(&src[shift..]) {
+        *a = a.max(*s);
+    }
+}
+
+impl SliceWork {
+    #[allow(clippy::too_many_arguments)]
+    fn score_slice(
+        &mut self,
+        occ: &[f32],
+        nx: usize,
+        ny: usize,
+        widths: usize,
+        f: usize,
+        best: &mut [f32],
+        per_a: &mut [&mut [u8]],
+    ) {
+        let n = nx * ny;
+        best.fill(0.0);
+        for s in per_a.iter_mut() {
+            s.fill(0);
+        }
+        // A slice without occupied voxels cannot hold a pole (the inside mean is ≈ 0).
+        if occ.iter().all(|&o| o < 0.05) || 1 + 2 * f > nx || 1 + 2 * f > ny {
+            return;
+        }
+        summed_area(occ, nx, ny, &mut self.table);
+        // Row/column maxima over the hull thickness f (once per slice).
+        self.rows_f.clear();
+        self.rows_f.extend_from_slice(occ);
+        self.cols_f.clear();
+        self.cols_f.extend_from_slice(occ);
+        for d in 1..f {
+            grow(&mut self.rows_f, occ, d * nx);
+            grow(&mut self.cols_f, occ, d);
+        }
+        // Strips of span 2f (width a = 0), grown by one per width below.
+        self.strip_h.clear();
+        self.strip_h.extend_from_slice(&self.rows_f);
+        self.strip_v.clear();
+        self.strip_v.extend_from_slice(&self.cols_f);
+        for s in 1..2 * f {
+            grow(&mut self.strip_h, &self.rows_f, s);
+            grow(&mut self.strip_v, &self.cols_f, s * nx);
+        }
+        self.raw.clear();
+        self.raw.resize(n, -1.0);
+        self.q.clear();
+        self.q.resize(n, -1.0);
+        for a in 1..=widths {
+            let span = a + 2 * f;
+            if span > nx || span > ny {
+                break;
+            }
+            grow(&mut self.strip_h, &self.rows_f, span - 1);
+            grow(&mut self.strip_v, &self.cols_f, (span - 1) * nx);
+            self.raw.fill(-1.0);
+            let inv_area = 1.0 / (a * a) as f64;
+            for ky in f..=(ny - a - f) {
+                for kx in f..=(nx - a - f) {
+                    let inside = box_sum(&self.table, nx, kx, ky, a, a) * inv_area;
+                    let below = self.strip_h[(ky - f) * nx + kx - f];
+                    let above = self.strip_h[(ky + a) * nx + kx - f];
+                    let left = self.strip_v[(ky - f) * nx + kx - f];
+                    let right = self.strip_v[(ky - f) * nx + kx + a];
+                    let hull = below.max(above).max(left).max(right);
+                    self.raw[ky * nx + kx] = inside as f32 - hull;
+                }
+            }
+            // q_a(j): best placement whose a × a footprint contains j (anchors j−a+1 ..= j).
+            let lo = -(a as isize - 1);
+            rect_max(
+                &self.raw,
+                nx,
+                ny,
+                (lo, a),
+                (lo, a),
+                -1.0,
+                &mut self.q,
+                &mut self.scratch,
+            );
+            let Some(bytes) = per_a.get_mut(a - 1) else {
+                continue;
+            };
+            for ((b, q), out) in best.iter_mut().zip(&self.q).zip(bytes.iter_mut()) {
+                let remapped = 0.5 * q + 0.5; // errata 12: q' = q/2 + 1/2
+                *b = b.max(remapped);
+                *out = (remapped.clamp(0.0, 1.0) * 255.0).round() as u8;
+            }
+        }
+    }
+}
