@@ -49,6 +49,72 @@ fn write_scene(path: &Path) {
 }
 
 #[test]
+fn baselines_share_the_interface() {
+    let dir = tempfile::tempdir().unwrap();
+    let scan = dir.path().join("scene.pcd");
+    write_scene(&scan);
+    for method in ["peac", "msac"] {
+        let labels = dir.path().join(format!("{method}.txt"));
+        let out = raypath(&[
+            "planes",
+            scan.to_str().unwrap(),
+            "--method",
+            method,
+            "--out",
+            labels.to_str().unwrap(),
+            "--json",
+        ]);
+        assert!(
+            out.status.success(),
+            "{method}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(doc["method"], method);
+        let planes = doc["planes"].as_array().unwrap();
+        assert!(!planes.is_empty(), "{method}: no plane");
+        for key in ["label", "normal", "distance", "points", "rmse"] {
+            assert!(planes[0].get(key).is_some(), "{method}: missing {key}");
+        }
+        assert_eq!(
+            std::fs::read_to_string(&labels).unwrap().lines().count(),
+            1200
+        );
+        if method == "peac" {
+            // The block graph finds the wall (3 m) and the floor (1 m); the pixel-wise
+            // refinement gives every ray to one of them, so both are correct detections.
+            let d: Vec<f64> = planes
+                .iter()
+                .map(|p| p["distance"].as_f64().unwrap())
+                .collect();
+            assert_eq!(d.len(), 2, "{d:?}");
+            assert!(d.iter().any(|d| (d - 3.0).abs() < 1e-3), "{d:?}");
+            assert!(d.iter().any(|d| (d - 1.0).abs() < 1e-3), "{d:?}");
+            let out = raypath(&[
+                "segcomp-eval",
+                "--truth",
+                scan.to_str().unwrap(),
+                "--labels",
+                labels.to_str().unwrap(),
+                "--json",
+            ]);
+            let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            assert_eq!(doc["correct"], 2, "{doc}");
+        }
+    }
+    let out = raypath(&["planes", scan.to_str().unwrap(), "--method", "nope"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nope"));
+    // Per-noise presets are accepted.
+    let out = raypath(&["planes", scan.to_str().unwrap(), "--preset", "synpeb-0.5"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
 fn planes_json_and_labels_round_trip_through_the_evaluator() {
     let dir = tempfile::tempdir().unwrap();
     let scan = dir.path().join("scene.pcd");

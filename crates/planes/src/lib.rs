@@ -15,6 +15,8 @@
 //! * [`compare`]: the Hoover et al. protocol with `T = 0.8`, k-value and angle deviation
 //!   ([`hoover`]).
 //! * [`msac()`](fn@msac): the iterative MSAC baseline (module [`mod@msac`]).
+//! * [`peac()`](fn@peac): the PEAC-style block-graph AHC baseline of Feng et al. (2014)
+//!   (module [`mod@peac`]).
 //! * [`PpeParams::synpeb`], [`PpeParams::segcomp`]: presets of the two benchmarks.
 //!
 //! Frames and units: the sensor frame (REP-103: x forward, y left, z up) with every ray
@@ -51,6 +53,7 @@ pub mod fit;
 pub mod hoover;
 pub mod msac;
 pub mod params;
+pub mod peac;
 pub mod ppe;
 pub mod stats;
 pub mod tetromino;
@@ -60,5 +63,6 @@ pub use fit::{PlaneFit, fit_plane, radial_sse};
 pub use hoover::{HooverParams, HooverResult, compare};
 pub use msac::{MsacParams, msac};
 pub use params::PpeParams;
+pub use peac::{PeacParams, peac};
 pub use ppe::{Plane, Segmentation, extract, extract_grid};
 pub use stats::PlaneStats;

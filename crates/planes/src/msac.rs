@@ -47,6 +47,18 @@ impl Default for MsacParams {
     }
 }
 
+impl MsacParams {
+    /// The parameters used on SynPEB-style scans: inlier distance 5 cm, stop at 10 %
+    /// remaining rays (not grid-searched).
+    pub fn synpeb() -> Self {
+        Self {
+            max_distance_m: 0.05,
+            remaining_fraction: 0.1,
+            ..Self::default()
+        }
+    }
+}
+
 /// Iterative MSAC on a row-major grid of endpoints (NaN = no return).
 pub fn msac(
     points: &[Vector3<f64>],

@@ -18,6 +18,13 @@ pub struct PpeParams {
     pub l_max_m: f64,
     /// Planes with fewer rays are dropped from the output (they are not regular planes).
     pub min_points: usize,
+    /// Post-processing rounds after the clustering (0: none, the thesis' algorithm).
+    /// Each round reassigns every ray on a plane boundary to the adjacent plane (of at
+    /// least `min_points` rays) with the least radial residual — rays of smaller planes
+    /// move when that residual is at most `√e` — and then merges 4-adjacent planes while
+    /// the increment stays within `e`, which joins pieces of one face that a thin strip of
+    /// another plane had kept apart. Not in the thesis; see the crate docs.
+    pub refine_rounds: usize,
 }
 
 impl Default for PpeParams {
@@ -27,24 +34,45 @@ impl Default for PpeParams {
             max_planes: None,
             l_max_m: f64::INFINITY,
             min_points: 4,
+            refine_rounds: 0,
         }
     }
 }
 
 impl PpeParams {
-    /// Preset for SynPEB-style scans (500 × 500, σ_rad = 2 cm). The reference
-    /// implementation's tuned values live in a binary `paramppe.mat` that the thesis does
-    /// not print; these lie on its grids (`√e` in 2 cm steps, `d` in 2 cm steps from
-    /// 2 to 20 cm): `√e = 0.20 m`, `d = 0.20 m`, from a coarse search on the 10
-    /// generated σ = 2 cm training scans (mean f: √e = 0.10 / 0.14 / 0.20 / 0.32 / 0.50 m →
-    /// 55.0 / 64.1 / 64.0 / 62.1 / 59.2 %, 0.14 and 0.20 tie; d = 0.40 m, off the grid: 65.1 %).
+    /// Preset for SynPEB-style scans (500 × 500, σ_rad = 2 cm), the same as
+    /// `synpeb-2.0` of [`PpeParams::synpeb_noise`].
     pub fn synpeb() -> Self {
-        Self {
-            max_increment_m2: 0.20 * 0.20,
+        Self::synpeb_noise("2.0").unwrap_or_default()
+    }
+
+    /// Presets for the noise levels of SynPEB (`"0.0"`, `"0.5"`, `"1.0"`, `"2.0"`, `"4.0"`:
+    /// radial σ in cm), each from a grid search on the 10 generated training scans of its
+    /// level maximizing the mean f (`cargo run --release -p raypath-planes --example
+    /// ppe_scan -- --refine 3 --e E --lmax D datasets/generated/synpeb/train/<σ>/*.pcd`):
+    /// `√e` ∈ {0.06, 0.10, 0.14, 0.20, 0.28, 0.40} m and `d = l_max` ∈ {0.10, 0.20} m, on
+    /// the reference implementation's grids (`√e` in 2 cm steps, `d` in 2 cm steps up to
+    /// 20 cm), with 3 refinement rounds and planes of at least 10 rays; `d = 0.20 m` wins
+    /// at every level. Best mean f on the training split: 85.6, 84.0, 79.3, 69.7 and
+    /// 56.5 % (σ = 0, 0.5, 1, 2, 4 cm). The reference implementation's own values live in a
+    /// binary `paramppe.mat` the thesis does not print.
+    pub fn synpeb_noise(level_cm: &str) -> Option<Self> {
+        // (√e in m, l_max in m) per level.
+        let (sqrt_e, l_max) = match level_cm {
+            "0.0" => (0.06, 0.20),
+            "0.5" => (0.06, 0.20),
+            "1.0" => (0.10, 0.20),
+            "2.0" => (0.20, 0.20),
+            "4.0" => (0.40, 0.20),
+            _ => return None,
+        };
+        Some(Self {
+            max_increment_m2: sqrt_e * sqrt_e,
             max_planes: None,
-            l_max_m: 0.20,
+            l_max_m: l_max,
             min_points: 10,
-        }
+            refine_rounds: 3,
+        })
     }
 
     /// Preset for the SegComp Perceptron scans (grids: `d` 4–40 mm); not tuned on the
@@ -55,16 +83,30 @@ impl PpeParams {
             max_planes: None,
             l_max_m: 0.02,
             min_points: 10,
+            refine_rounds: 0,
         }
     }
 
-    /// A preset by name (`synpeb`, `segcomp`, `default`).
+    /// The names [`PpeParams::preset`] accepts.
+    pub const PRESETS: [&'static str; 8] = [
+        "synpeb",
+        "synpeb-0.0",
+        "synpeb-0.5",
+        "synpeb-1.0",
+        "synpeb-2.0",
+        "synpeb-4.0",
+        "segcomp",
+        "default",
+    ];
+
+    /// A preset by name (one of [`PpeParams::PRESETS`]; `synpeb-<σ>` are the noise levels
+    /// of [`PpeParams::synpeb_noise`]).
     pub fn preset(name: &str) -> Option<Self> {
         match name {
             "synpeb" => Some(Self::synpeb()),
             "segcomp" => Some(Self::segcomp()),
             "default" => Some(Self::default()),
-            _ => None,
+            _ => name.strip_prefix("synpeb-").and_then(Self::synpeb_noise),
         }
     }
 

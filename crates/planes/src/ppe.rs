@@ -124,6 +124,7 @@ pub fn extract_grid(
     }
     let mut state = State::new(points, width, height, params);
     state.run();
+    state.polish();
     Ok(state.finish())
 }
 
@@ -584,6 +585,271 @@ impl<'a> State<'a> {
         cl.members.extend(moved);
         self.plane_count -= 1;
         self.steps += 1;
+    }
+
+    /// The post-processing rounds of [`PpeParams::refine_rounds`].
+    fn polish(&mut self) {
+        for _ in 0..self.params.refine_rounds {
+            let moved = self.refine_boundary();
+            let mut merged = self.merge_adjacent();
+            merged += self.merge_occluded();
+            if moved == 0 && merged == 0 {
+                break;
+            }
+        }
+    }
+
+    /// Absolute radial residual of ray `k` on plane `w` (`∞` when the ray misses it).
+    fn residual(&self, w: &Vector3<f64>, k: usize) -> f64 {
+        let p = &self.points[k];
+        let r = p.norm();
+        let d = w.dot(p) / r;
+        if d > 0.0 {
+            (r - 1.0 / d).abs()
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// One sweep of boundary refinement; returns the number of rays moved.
+    fn refine_boundary(&mut self) -> usize {
+        let min_points = self.params.min_points.max(4);
+        let big: Vec<Option<Vector3<f64>>> = self
+            .clusters
+            .iter()
+            .enumerate()
+            .map(|(id, cl)| {
+                (cl.parent as usize == id && cl.members.len() >= min_points)
+                    .then(|| cl.stats.solve().map(|(w, _)| w))
+                    .flatten()
+            })
+            .collect();
+        let plane_of = |l: u32| big.get(l as usize).copied().flatten();
+        let limit = self.params.max_increment_m2.sqrt();
+        let neighbours = [(-1i8, 0i8), (1, 0), (0, -1), (0, 1)];
+        let mut moves = Vec::new();
+        for k in 0..self.points.len() {
+            let own = self.label[k];
+            if own == NONE {
+                continue;
+            }
+            let mut best: Option<(f64, u32)> = plane_of(own).map(|w| (self.residual(&w, k), own));
+            let own_big = best.is_some();
+            let mut boundary = false;
+            for d in neighbours {
+                let Some(o) = self.cell(k, d) else { continue };
+                let lo = self.label[o];
+                if lo == NONE || lo == own || !self.edge(k, o) {
+                    continue;
+                }
+                boundary = true;
+                if let Some(w) = plane_of(lo) {
+                    let e = self.residual(&w, k);
+                    if best.is_none_or(|(b, _)| e < b) {
+                        best = Some((e, lo));
+                    }
+                }
+            }
+            if !boundary {
+                continue;
+            }
+            if let Some((e, to)) = best
+                && to != own
+                && (own_big || e <= limit)
+            {
+                moves.push((k, to));
+            }
+        }
+        for &(k, to) in &moves {
+            let from = self.label[k];
+            let ps = self.point_stats[k];
+            self.clusters[from as usize].stats.remove(&ps);
+            self.clusters[to as usize].stats.add(&ps);
+            self.label[k] = to;
+        }
+        if !moves.is_empty() {
+            for cl in &mut self.clusters {
+                cl.members.clear();
+            }
+            for (k, &l) in self.label.iter().enumerate() {
+                if l != NONE {
+                    self.clusters[l as usize].members.push(k as u32);
+                }
+            }
+            for cl in &mut self.clusters {
+                cl.error = if cl.members.len() >= 4 {
+                    cl.stats.error()
+                } else {
+                    0.0
+                };
+            }
+        }
+        moves.len()
+    }
+
+    /// Merges 4-adjacent planes, least increment first, while the increment is at most
+    /// `e`; returns the number of merges.
+    fn merge_adjacent(&mut self) -> usize {
+        let mut pairs = Vec::new();
+        for k in 0..self.points.len() {
+            let a = self.label[k];
+            if a == NONE {
+                continue;
+            }
+            for o in [k + 1, k + self.width] {
+                if o < self.points.len() && self.edge(k, o) {
+                    let b = self.label[o];
+                    if b != NONE && b != a {
+                        pairs.push((a.min(b), a.max(b)));
+                    }
+                }
+            }
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+        let e_max = self.params.max_increment_m2;
+        let mut heap: BinaryHeap<Entry> = pairs
+            .into_iter()
+            .filter(|&(a, b)| {
+                self.clusters[a as usize].members.len() >= 4
+                    && self.clusters[b as usize].members.len() >= 4
+            })
+            .map(|(a, b)| Entry {
+                key: self.mrg_increment(a, b),
+                action: Action::Merge { a, b },
+            })
+            .filter(|e| e.key <= e_max)
+            .collect();
+        let mut merged = 0;
+        while let Some(entry) = heap.pop() {
+            let Action::Merge { a, b } = entry.action else {
+                continue;
+            };
+            let (ra, rb) = (self.root(a), self.root(b));
+            if ra == rb {
+                continue;
+            }
+            let key = self.mrg_increment(ra, rb);
+            if key > e_max {
+                continue;
+            }
+            if key > entry.key && heap.peek().is_some_and(|n| key > n.key) {
+                heap.push(Entry {
+                    key,
+                    action: Action::Merge { a: ra, b: rb },
+                });
+                continue;
+            }
+            self.merge(ra, rb);
+            merged += 1;
+        }
+        merged
+    }
+
+    /// Merges planes that are pieces of one surface seen on both sides of an occluder:
+    /// along a row or column, plane `a` ends, only rays **in front of** the joint plane of
+    /// `a` and `b` follow (by more than three RMS residuals of the joint fit), then plane `b`
+    /// begins; the merge is executed when its increment is at most `e`. Returns the number
+    /// of merges.
+    fn merge_occluded(&mut self) -> usize {
+        let min_points = self.params.min_points.max(4);
+        let e_max = self.params.max_increment_m2;
+        let is_big = |s: &Self, l: u32| {
+            l != NONE
+                && s.clusters
+                    .get(l as usize)
+                    .is_some_and(|c| c.members.len() >= min_points)
+        };
+        // Candidate gaps: (a, b, first gap ray, last gap ray, stride).
+        let mut gaps: Vec<(u32, u32, usize, usize, usize)> = Vec::new();
+        let lines = (0..self.height)
+            .map(|row| (row * self.width, 1, self.width))
+            .chain((0..self.width).map(|col| (col, self.width, self.height)));
+        for (start, stride, len) in lines {
+            // The last ray of the most recent distinct planes along the line.
+            let mut recent: [(u32, usize); 4] = [(NONE, 0); 4];
+            for i in 0..len {
+                let k = start + i * stride;
+                let l = self.label[k];
+                if !is_big(self, l) {
+                    continue;
+                }
+                if recent[0].0 != l {
+                    for &(a, ka) in &recent {
+                        if a != NONE && a != l && k - ka > stride {
+                            gaps.push((a.min(l), a.max(l), ka + stride, k - stride, stride));
+                        }
+                    }
+                    if let Some(pos) = recent.iter().position(|r| r.0 == l) {
+                        recent[..=pos].rotate_right(1);
+                    } else {
+                        recent.rotate_right(1);
+                    }
+                }
+                recent[0] = (l, k);
+            }
+        }
+        // Joint plane and occlusion margin of each pair.
+        type Joint = Option<(Vector3<f64>, f64)>;
+        let mut cache: std::collections::HashMap<(u32, u32), Joint> =
+            std::collections::HashMap::new();
+        let mut pairs = Vec::new();
+        for (a, b, first, last, stride) in gaps {
+            let joint = *cache.entry((a, b)).or_insert_with(|| {
+                let st = self.clusters[a as usize]
+                    .stats
+                    .union(&self.clusters[b as usize].stats);
+                st.solve()
+                    .map(|(w, sse)| (w, 3.0 * (sse / st.n.max(1) as f64).sqrt()))
+            });
+            let Some((w, margin)) = joint else { continue };
+            let occluded = (first..=last).step_by(stride).all(|k| {
+                let p = &self.points[k];
+                if !self.valid[k] {
+                    return false;
+                }
+                let r = p.norm();
+                let d = w.dot(p) / r;
+                d > 0.0 && r < 1.0 / d - margin
+            });
+            if occluded {
+                pairs.push((a, b));
+            }
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+        let mut heap: BinaryHeap<Entry> = pairs
+            .into_iter()
+            .map(|(a, b)| Entry {
+                key: self.mrg_increment(a, b),
+                action: Action::Merge { a, b },
+            })
+            .filter(|e| e.key <= e_max)
+            .collect();
+        let mut merged = 0;
+        while let Some(entry) = heap.pop() {
+            let Action::Merge { a, b } = entry.action else {
+                continue;
+            };
+            let (ra, rb) = (self.root(a), self.root(b));
+            if ra == rb {
+                continue;
+            }
+            let key = self.mrg_increment(ra, rb);
+            if key > e_max {
+                continue;
+            }
+            if key > entry.key && heap.peek().is_some_and(|n| key > n.key) {
+                heap.push(Entry {
+                    key,
+                    action: Action::Merge { a: ra, b: rb },
+                });
+                continue;
+            }
+            self.merge(ra, rb);
+            merged += 1;
+        }
+        merged
     }
 
     fn finish(self) -> Segmentation {

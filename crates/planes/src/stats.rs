@@ -60,6 +60,14 @@ impl PlaneStats {
         self.n += other.n;
     }
 
+    /// Removes a subset previously added (the inverse of [`PlaneStats::add`]).
+    pub fn remove(&mut self, other: &Self) {
+        self.a -= other.a;
+        self.b -= other.b;
+        self.c -= other.c;
+        self.n = self.n.saturating_sub(other.n);
+    }
+
     /// The union of two sets.
     pub fn union(&self, other: &Self) -> Self {
         let mut s = *self;

@@ -215,3 +215,82 @@ fn l_max_separates_and_params_are_checked() {
             .is_empty()
     );
 }
+
+/// A wall `x = 4 m` behind a full-height pillar (front face `x = 2.5 m`, `|y| < 0.4 m`),
+/// seen by a `w × h` fan with radial noise `sigma`.
+fn pillar_scene(w: usize, h: usize, sigma: f64, seed: u64) -> Vec<Vector3<f64>> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let noise = Normal::new(0.0, sigma.max(1e-300)).expect("valid sigma");
+    let mut pts = Vec::with_capacity(w * h);
+    for row in 0..h {
+        for col in 0..w {
+            let v = unit(
+                (col as f64 / (w - 1) as f64 - 0.5) * 1.0,
+                0.3 - row as f64 / (h - 1) as f64 * 0.6,
+            );
+            let pillar = 2.5 / v.x;
+            let t = if (v * pillar).y.abs() < 0.4 {
+                pillar
+            } else {
+                4.0 / v.x
+            };
+            let n = if sigma > 0.0 {
+                noise.sample(&mut rng)
+            } else {
+                0.0
+            };
+            pts.push(v * (t + n));
+        }
+    }
+    pts
+}
+
+#[test]
+fn refinement_joins_a_wall_split_by_an_occluder() {
+    for (sigma, seed) in [(0.0, 5), (0.01, 6)] {
+        let pts = pillar_scene(60, 30, sigma, seed);
+        let plain = PpeParams {
+            l_max_m: 0.3,
+            max_increment_m2: 0.05 * 0.05,
+            min_points: 10,
+            ..PpeParams::default()
+        };
+        let wall_planes = |seg: &raypath_planes::Segmentation| {
+            seg.planes
+                .iter()
+                .filter(|p| (p.fit.distance_m() - 4.0).abs() < 0.05 && p.index.len() >= 100)
+                .count()
+        };
+        let seg = extract_grid(&pts, 60, 30, &plain).expect("extract");
+        assert!(
+            wall_planes(&seg) >= 2,
+            "σ {sigma}: the pieces are not adjacent"
+        );
+        let refined = PpeParams {
+            refine_rounds: 3,
+            ..plain
+        };
+        let seg = extract_grid(&pts, 60, 30, &refined).expect("extract");
+        assert_eq!(wall_planes(&seg), 1, "σ {sigma}: one wall after refinement");
+        let wall = &seg.planes[0];
+        assert!((wall.fit.distance_m() - 4.0).abs() < 0.01);
+        // The pillar stays a plane of its own, and the labels remain a partition whose
+        // plane fits are exact.
+        assert!(
+            seg.planes
+                .iter()
+                .any(|p| (p.fit.distance_m() - 2.5).abs() < 0.02 && p.index.len() >= 100)
+        );
+        for (id, p) in seg.planes.iter().enumerate() {
+            assert!(p.index.iter().all(|&i| seg.labels[i] == Some(id as u32)));
+            let members: Vec<_> = p.index.iter().map(|&i| pts[i]).collect();
+            let sse = radial_sse(&p.fit.w, &members);
+            assert!((sse - p.fit.sse).abs() <= 1e-9 * (1.0 + sse));
+        }
+        let labelled = seg.labels.iter().filter(|l| l.is_some()).count();
+        assert_eq!(
+            labelled,
+            seg.planes.iter().map(|p| p.index.len()).sum::<usize>()
+        );
+    }
+}
