@@ -2,7 +2,7 @@
 //!
 //! Unfused base cubes are found in O(1) instead of an R-tree descent. The table stores only
 //! the 4-byte cell id per slot; the key is read back from the cell, so an entry costs
-//! 4 bytes / load factor (≤ ½) — 8 to 16 bytes per indexed cell. Linear probing with
+//! 4 bytes / load factor (≤ ¾) — 5.3 to 10.7 bytes per indexed cell. Linear probing with
 //! backward-shift deletion (no tombstones).
 
 use crate::key::{Key, pack};
@@ -68,7 +68,7 @@ impl LatticeIndex {
 
     /// Stores `id` for `key` (the key must not be present).
     pub fn insert(&mut self, key: Key, id: u32, key_of: impl Fn(u32) -> Key) {
-        if (self.len + 1) * 2 > self.slots.len() {
+        if (self.len + 1) * 4 > self.slots.len() * 3 {
             self.grow(&key_of);
         }
         let mask = self.mask();
@@ -82,6 +82,7 @@ impl LatticeIndex {
 
     fn grow(&mut self, key_of: &impl Fn(u32) -> Key) {
         let new_len = (self.slots.len() * 2).max(64);
+        debug_assert!(new_len.is_power_of_two());
         let old = std::mem::replace(&mut self.slots, vec![EMPTY; new_len]);
         let mask = self.mask();
         for id in old.into_iter().filter(|&id| id != EMPTY) {

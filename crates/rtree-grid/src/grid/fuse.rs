@@ -55,7 +55,7 @@ impl RtreeGrid {
         let mut steps = 0;
         let mut members: Vec<u32> = Vec::new();
         loop {
-            let cell = self.cells[id as usize];
+            let cell = self.cell(id);
             if cell.log_odds.is_nan() {
                 return steps; // removed earlier in this pass
             }
@@ -82,7 +82,7 @@ impl RtreeGrid {
             // cell, g_i included); all are clamped to the same bound.
             let mut sum = f64::from(cell.log_odds);
             for &m in &members {
-                sum += f64::from(self.cells[m as usize].log_odds);
+                sum += f64::from(self.log_odds[m as usize]);
             }
             let mean = (sum / (members.len() + 1) as f64) as f32;
             self.delete_cell(id);
@@ -104,8 +104,8 @@ impl RtreeGrid {
         let target = slab.volume();
         if target == 1 {
             // A single base cube: one index look-up.
-            return match self.index.get(slab.lo, Self::key_of_cell(&self.cells)) {
-                Some(id) if self.is_clamped(self.cells[id as usize].log_odds) == Some(occupied) => {
+            return match self.index.get(slab.lo, Self::key_of_cell(&self.tree)) {
+                Some(id) if self.is_clamped(self.log_odds[id as usize]) == Some(occupied) => {
                     members.push(id);
                     true
                 }
@@ -117,7 +117,7 @@ impl RtreeGrid {
                 return;
             }
             if !slab.contains_box(bx)
-                || self.is_clamped(self.cells[id as usize].log_odds) != Some(occupied)
+                || self.is_clamped(self.log_odds[id as usize]) != Some(occupied)
             {
                 ok = false;
                 return;

@@ -16,7 +16,8 @@ use crate::rtree::{OrderError, RTree};
 
 pub use query::{Cuboid, Occupancy};
 
-/// A leaf cell: its box of base cubes and its log-odds (16 bytes).
+/// A leaf cell: its box of base cubes (stored once, in the tree) and its log-odds
+/// (4 bytes, in `log_odds`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Cell {
     bx: KeyBox,
@@ -76,7 +77,7 @@ pub struct GridStats {
 pub struct RtreeGrid {
     config: GridConfig,
     tree: RTree,
-    cells: Vec<Cell>,
+    log_odds: Vec<f32>,
     free_cells: Vec<u32>,
     index: LatticeIndex,
     fused_cells: usize,
@@ -133,7 +134,7 @@ impl RtreeGrid {
         Ok(Self {
             config,
             tree,
-            cells: Vec::new(),
+            log_odds: Vec::new(),
             free_cells: Vec::new(),
             index: LatticeIndex::default(),
             fused_cells: 0,
@@ -172,8 +173,17 @@ impl RtreeGrid {
     }
 
     #[inline]
-    fn key_of_cell(cells: &[Cell]) -> impl Fn(u32) -> Key + '_ {
-        move |id| cells[id as usize].bx.lo
+    fn key_of_cell(tree: &RTree) -> impl Fn(u32) -> Key + '_ {
+        move |id| tree.item_box(id).map_or([0; 3], |b| b.lo)
+    }
+
+    /// The cell `id` (box from the tree, log-odds; NaN log-odds for a dead id).
+    #[inline]
+    fn cell(&self, id: u32) -> Cell {
+        Cell {
+            bx: self.tree.item_box(id).unwrap_or(KeyBox::cube([0; 3])),
+            log_odds: self.log_odds[id as usize],
+        }
     }
 
     /// Inserts one scan of a sensor at `world_from_sensor` with points in the sensor frame;
@@ -303,7 +313,7 @@ impl RtreeGrid {
 
     /// The id of the cell containing base cube `key`.
     fn cell_id_of_key(&self, key: Key) -> Option<u32> {
-        if let Some(id) = self.index.get(key, Self::key_of_cell(&self.cells)) {
+        if let Some(id) = self.index.get(key, Self::key_of_cell(&self.tree)) {
             return Some(id);
         }
         if self.fused_cells == 0 {
@@ -321,14 +331,14 @@ impl RtreeGrid {
     /// Applies one update to the cell holding `key` (creating it); returns the cell id for
     /// base cubes, `None` for a fused cell (queued, updated once per scan).
     fn update_key(&mut self, key: Key, hit: bool, update: &mut ScanUpdate) -> Option<u32> {
-        if let Some(id) = self.index.get(key, Self::key_of_cell(&self.cells)) {
-            let l = self.cells[id as usize].log_odds;
-            self.cells[id as usize].log_odds = self.updated(l, hit);
+        if let Some(id) = self.index.get(key, Self::key_of_cell(&self.tree)) {
+            let l = self.log_odds[id as usize];
+            self.log_odds[id as usize] = self.updated(l, hit);
             return Some(id);
         }
         if self.fused_cells > 0 {
             if let Some((id, bx)) = self.tree.find_containing(key) {
-                let l = self.cells[id as usize].log_odds;
+                let l = self.log_odds[id as usize];
                 let leaves_clamp = self.is_clamped(l).is_some()
                     && self.is_clamped(self.updated(l, hit)) != self.is_clamped(l);
                 if self.config.split_on_unclamp && leaves_clamp && bx.volume() <= MAX_SPLIT {
@@ -355,9 +365,9 @@ impl RtreeGrid {
             if touched.get(i + 1).is_some_and(|next| next.0 == id) {
                 continue;
             }
-            let l = self.cells[id as usize].log_odds;
+            let l = self.log_odds[id as usize];
             if !l.is_nan() {
-                self.cells[id as usize].log_odds = self.updated(l, hit);
+                self.log_odds[id as usize] = self.updated(l, hit);
             }
         }
         touched.clear();
@@ -377,33 +387,31 @@ impl RtreeGrid {
     }
 
     fn create_cell(&mut self, bx: KeyBox, log_odds: f32) -> u32 {
-        let cell = Cell { bx, log_odds };
         let id = if let Some(id) = self.free_cells.pop() {
-            self.cells[id as usize] = cell;
+            self.log_odds[id as usize] = log_odds;
             id
         } else {
-            self.cells.push(cell);
-            (self.cells.len() - 1) as u32
+            self.log_odds.push(log_odds);
+            (self.log_odds.len() - 1) as u32
         };
+        self.tree.insert(id, bx);
         if bx.volume() == 1 {
-            self.index.insert(bx.lo, id, Self::key_of_cell(&self.cells));
+            self.index.insert(bx.lo, id, Self::key_of_cell(&self.tree));
         } else {
             self.fused_cells += 1;
         }
-        self.tree.insert(id, bx);
         id
     }
 
     fn delete_cell(&mut self, id: u32) -> Cell {
-        let cell = self.cells[id as usize];
+        let cell = self.cell(id);
         if cell.bx.volume() == 1 {
-            self.index
-                .remove(cell.bx.lo, Self::key_of_cell(&self.cells));
+            self.index.remove(cell.bx.lo, Self::key_of_cell(&self.tree));
         } else {
             self.fused_cells -= 1;
         }
-        self.tree.remove(id, &cell.bx);
-        self.cells[id as usize].log_odds = f32::NAN;
+        self.tree.remove(id);
+        self.log_odds[id as usize] = f32::NAN;
         self.free_cells.push(id);
         cell
     }
@@ -433,18 +441,18 @@ impl RtreeGrid {
         };
         self.tree.for_each_item(&mut |id, bx| {
             stats.base_cubes += bx.volume();
-            if self.cells[id as usize].log_odds > self.l_threshold {
+            if self.log_odds[id as usize] > self.l_threshold {
                 stats.occupied_leaves += 1;
             }
         });
         stats
     }
 
-    /// Bytes allocated by the map: the tree arena, the cell arena (16 B per cell), the free
+    /// Bytes allocated by the map: the tree arena (with the cell boxes), the log-odds (4 B per cell), the free
     /// list and the lattice index (excluding per-scan scratch vectors).
     pub fn memory_bytes(&self) -> usize {
         self.tree.memory_bytes()
-            + self.cells.capacity() * size_of::<Cell>()
+            + self.log_odds.capacity() * size_of::<f32>()
             + self.free_cells.capacity() * 4
             + self.index.memory_bytes()
             + size_of::<Self>()
@@ -452,7 +460,8 @@ impl RtreeGrid {
 
     /// Releases spare capacity (per-scan scratch and vector slack).
     pub fn shrink_to_fit(&mut self) {
-        self.cells.shrink_to_fit();
+        self.tree.shrink_to_fit();
+        self.log_odds.shrink_to_fit();
         self.free_cells.shrink_to_fit();
         self.free_keys = Vec::new();
         self.occupied_keys = Vec::new();

@@ -35,7 +35,7 @@ pub struct Cuboid {
 impl RtreeGrid {
     fn cuboid(&self, id: u32, bx: &KeyBox) -> Cuboid {
         let r = self.config.resolution_m;
-        let l = self.cells[id as usize].log_odds;
+        let l = self.log_odds[id as usize];
         Cuboid {
             min_m: bx.min_m(r),
             max_m: bx.max_m(r),
@@ -49,7 +49,7 @@ impl RtreeGrid {
     pub fn cell_at(&self, point_m: &Point3<f64>) -> Option<Cuboid> {
         let key = key_of([point_m.x, point_m.y, point_m.z], self.config.resolution_m)?;
         let id = self.cell_id_of_key(key)?;
-        Some(self.cuboid(id, &self.cells[id as usize].bx))
+        Some(self.cuboid(id, &self.cell(id).bx))
     }
 
     /// Occupancy probability at `point_m` (`None`: unknown space).
@@ -96,7 +96,7 @@ impl RtreeGrid {
             let Some(id) = self.cell_id_of_key(key) else {
                 continue;
             };
-            if self.cells[id as usize].log_odds > self.l_threshold {
+            if self.log_odds[id as usize] > self.l_threshold {
                 let cube = KeyBox::cube(key);
                 let r = self.config.resolution_m;
                 let (lo, hi) = (cube.min_m(r), cube.max_m(r));
@@ -110,7 +110,7 @@ impl RtreeGrid {
                         t_enter = t_enter.max(t1.min(t2));
                     }
                 }
-                return Some((self.cuboid(id, &self.cells[id as usize].bx), t_enter));
+                return Some((self.cuboid(id, &self.cell(id).bx), t_enter));
             }
         }
         None
@@ -135,7 +135,7 @@ impl RtreeGrid {
         let mut n = 0;
         let threshold = self.l_threshold;
         self.tree.for_each_item(&mut |id, bx| {
-            if self.cells[id as usize].log_odds > threshold {
+            if self.log_odds[id as usize] > threshold {
                 n += 1;
                 visit(bx);
             }

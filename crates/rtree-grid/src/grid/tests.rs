@@ -8,7 +8,7 @@ fn check(grid: &RtreeGrid) -> u64 {
     grid.tree.check_invariants().unwrap();
     let mut boxes = Vec::new();
     grid.tree.for_each_item(&mut |id, bx| {
-        assert_eq!(grid.cells[id as usize].bx, *bx);
+        assert_eq!(grid.cell(id).bx, *bx);
         boxes.push(*bx);
     });
     for (i, a) in boxes.iter().enumerate() {
@@ -78,7 +78,7 @@ proptest! {
         // was updated after fusing; so check the weaker, exact property on the fused leaves.
         let mut mixed = 0;
         grid.tree.for_each_item(&mut |id, bx| {
-            if bx.volume() > 1 && grid.is_clamped(grid.cells[id as usize].log_odds).is_none() {
+            if bx.volume() > 1 && grid.is_clamped(grid.log_odds[id as usize]).is_none() {
                 mixed += 1;
             }
         });
@@ -110,9 +110,9 @@ fn fused_leaves_hold_one_polarity_of_the_plain_grid() {
                 for x in lo[0]..=hi[0] {
                     let id = reference
                         .index
-                        .get([x, y, z], RtreeGrid::key_of_cell(&reference.cells))
+                        .get([x, y, z], RtreeGrid::key_of_cell(&reference.tree))
                         .unwrap();
-                    let l = reference.cells[id as usize].log_odds;
+                    let l = reference.log_odds[id as usize];
                     assert_eq!(l > reference.l_threshold, c.occupied);
                 }
             }

@@ -7,11 +7,12 @@
 //! quadratic split; deletion removes the entry, tightens the boxes on the path to the root and
 //! re-inserts the entries of nodes that fall below `d` at their own level (CondenseTree).
 //!
-//! Nodes live in one arena: node `n` owns the `M + 1` entry slots `n·(M+1) ..` of the flat
-//! `boxes`/`ids` vectors (one spare slot takes the overflowing entry before a split), so no
-//! node is a separate heap allocation and a leaf entry is 16 bytes (a 12-byte box and a
-//! 4-byte item id). Freed nodes are recycled. Item ids are opaque `u32`s chosen by the caller;
-//! the tree never looks inside them.
+//! Nodes live in one arena: node `n` owns the `M + 1` child-id slots `n·(M+1) ..` of the
+//! flat `ids` vector (one spare slot takes the overflowing entry before a split); inner nodes
+//! also own a block of `M + 1` boxes in `inner_boxes`. Item boxes are stored once, indexed by
+//! item id (`item_boxes`), so a leaf entry costs a 4-byte slot plus the item's 12-byte box, and
+//! no node is a separate heap allocation. Freed nodes and box blocks are recycled. Item ids
+//! are small `u32`s chosen by the caller (dense ids keep `item_boxes` compact).
 //!
 //! Complexity (n items, h = log_d n levels): insertion `O(h·M)` plus `O(M²)` per split;
 //! deletion a FindLeaf search (`O(h·M)` without overlaps) plus `O(h·M)` tightening; box and
@@ -49,7 +50,10 @@ pub struct RTree {
     max_entries: usize,
     min_entries: usize,
     cap: usize,
-    boxes: Vec<KeyBox>,
+    item_boxes: Vec<KeyBox>,
+    inner_boxes: Vec<KeyBox>,
+    box_block: Vec<u32>,
+    free_blocks: Vec<u32>,
     ids: Vec<u32>,
     count: Vec<u8>,
     parent: Vec<u32>,
@@ -77,7 +81,10 @@ impl RTree {
             max_entries,
             min_entries,
             cap: max_entries + 1,
-            boxes: Vec::new(),
+            item_boxes: Vec::new(),
+            inner_boxes: Vec::new(),
+            box_block: Vec::new(),
+            free_blocks: Vec::new(),
             ids: Vec::new(),
             count: Vec::new(),
             parent: Vec::new(),
@@ -125,7 +132,8 @@ impl RTree {
     /// Bytes held by the arena (allocated capacity of every vector).
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of;
-        self.boxes.capacity() * size_of::<KeyBox>()
+        (self.item_boxes.capacity() + self.inner_boxes.capacity()) * size_of::<KeyBox>()
+            + (self.box_block.capacity() + self.free_blocks.capacity()) * 4
             + self.ids.capacity() * 4
             + self.count.capacity()
             + self.parent.capacity() * 4
@@ -136,73 +144,152 @@ impl RTree {
             + size_of::<Self>()
     }
 
+    /// Releases spare capacity of the arena.
+    pub fn shrink_to_fit(&mut self) {
+        self.item_boxes.shrink_to_fit();
+        self.inner_boxes.shrink_to_fit();
+        self.box_block.shrink_to_fit();
+        self.free_blocks.shrink_to_fit();
+        self.ids.shrink_to_fit();
+        self.count.shrink_to_fit();
+        self.parent.shrink_to_fit();
+        self.level.shrink_to_fit();
+        self.free_nodes.shrink_to_fit();
+        self.scratch = Vec::new();
+        self.orphans = Vec::new();
+    }
+
     #[inline]
     fn slot(&self, node: u32, i: usize) -> usize {
         node as usize * self.cap + i
     }
 
-    #[inline]
-    fn entries(&self, node: u32) -> std::ops::Range<usize> {
-        let start = node as usize * self.cap;
-        start..start + usize::from(self.count[node as usize])
-    }
-
     fn alloc_node(&mut self, level: u8) -> u32 {
-        if let Some(n) = self.free_nodes.pop() {
+        let n = if let Some(n) = self.free_nodes.pop() {
             self.count[n as usize] = 0;
             self.parent[n as usize] = NONE;
             self.level[n as usize] = level;
-            return n;
+            n
+        } else {
+            let n = self.count.len() as u32;
+            self.ids.resize(self.ids.len() + self.cap, NONE);
+            self.count.push(0);
+            self.parent.push(NONE);
+            self.level.push(level);
+            self.box_block.push(NONE);
+            n
+        };
+        if level > 0 {
+            self.give_block(n);
         }
-        let n = self.count.len() as u32;
-        let empty = KeyBox::cube([0; 3]);
-        self.boxes.resize(self.boxes.len() + self.cap, empty);
-        self.ids.resize(self.ids.len() + self.cap, NONE);
-        self.count.push(0);
-        self.parent.push(NONE);
-        self.level.push(level);
         n
+    }
+
+    /// Gives an inner node its block of entry boxes.
+    fn give_block(&mut self, node: u32) {
+        let block = if let Some(b) = self.free_blocks.pop() {
+            b
+        } else {
+            let b = (self.inner_boxes.len() / self.cap) as u32;
+            let empty = KeyBox::cube([0; 3]);
+            self.inner_boxes
+                .resize(self.inner_boxes.len() + self.cap, empty);
+            b
+        };
+        self.box_block[node as usize] = block;
     }
 
     fn free_node(&mut self, node: u32) {
         self.count[node as usize] = 0;
         self.parent[node as usize] = NONE;
+        let block = std::mem::replace(&mut self.box_block[node as usize], NONE);
+        if block != NONE {
+            self.free_blocks.push(block);
+        }
         self.free_nodes.push(node);
+    }
+
+    /// The box of entry `i` of `node`.
+    #[inline]
+    fn entry_box(&self, node: u32, i: usize) -> KeyBox {
+        let block = self.box_block[node as usize];
+        if block == NONE {
+            self.item_boxes[self.ids[self.slot(node, i)] as usize]
+        } else {
+            self.inner_boxes[block as usize * self.cap + i]
+        }
+    }
+
+    /// Sets the box of entry `i` of an inner node.
+    #[inline]
+    fn set_entry_box(&mut self, node: u32, i: usize, bx: KeyBox) {
+        let block = self.box_block[node as usize];
+        if block != NONE {
+            self.inner_boxes[block as usize * self.cap + i] = bx;
+        }
+    }
+
+    /// The box stored for `item` (meaningful only while the item is in the tree).
+    pub fn item_box(&self, item: u32) -> Option<KeyBox> {
+        self.item_boxes.get(item as usize).copied()
+    }
+
+    #[inline]
+    fn len_of(&self, node: u32) -> usize {
+        usize::from(self.count[node as usize])
+    }
+
+    #[inline]
+    fn id_at(&self, node: u32, i: usize) -> u32 {
+        self.ids[self.slot(node, i)]
     }
 
     /// The tight bounding box of a node's entries (`None` when it is empty).
     fn node_box(&self, node: u32) -> Option<KeyBox> {
-        let range = self.entries(node);
-        let mut iter = self.boxes[range].iter();
-        let first = *iter.next()?;
-        Some(iter.fold(first, |acc, b| acc.union(b)))
+        let n = self.len_of(node);
+        if n == 0 {
+            return None;
+        }
+        let mut acc = self.entry_box(node, 0);
+        for i in 1..n {
+            acc = acc.union(&self.entry_box(node, i));
+        }
+        Some(acc)
     }
 
     fn push_entry(&mut self, node: u32, bx: KeyBox, id: u32) {
-        let s = self.slot(node, usize::from(self.count[node as usize]));
-        self.boxes[s] = bx;
+        let i = self.len_of(node);
+        let s = self.slot(node, i);
         self.ids[s] = id;
         self.count[node as usize] += 1;
         if self.level[node as usize] > 0 {
+            self.set_entry_box(node, i, bx);
             self.parent[id as usize] = node;
+        } else {
+            let id = id as usize;
+            if id >= self.item_boxes.len() {
+                self.item_boxes.resize(id + 1, KeyBox::cube([0; 3]));
+            }
+            self.item_boxes[id] = bx;
         }
     }
 
     fn remove_slot(&mut self, node: u32, i: usize) {
-        let last = usize::from(self.count[node as usize]) - 1;
+        let last = self.len_of(node) - 1;
         let (a, b) = (self.slot(node, i), self.slot(node, last));
-        self.boxes.swap(a, b);
         self.ids.swap(a, b);
+        let block = self.box_block[node as usize];
+        if block != NONE {
+            let base = block as usize * self.cap;
+            self.inner_boxes.swap(base + i, base + last);
+        }
         self.count[node as usize] -= 1;
     }
 
-    fn slot_of_child(&self, parent: u32, child: u32) -> usize {
-        let range = self.entries(parent);
-        let start = range.start;
-        self.ids[range]
-            .iter()
-            .position(|&c| c == child)
-            .map_or(start, |i| start + i)
+    fn index_of_child(&self, parent: u32, child: u32) -> usize {
+        (0..self.len_of(parent))
+            .find(|&i| self.id_at(parent, i) == child)
+            .unwrap_or(0)
     }
 
     /// Inserts `item` with box `bx` (Guttman Insert: least enlargement, quadratic split).
@@ -215,17 +302,17 @@ impl RTree {
     fn insert_at_level(&mut self, bx: KeyBox, id: u32, level: u8) {
         let mut node = self.root;
         while self.level[node as usize] > level {
-            let mut best = self.slot(node, 0);
+            let mut best = 0;
             let mut best_key = (u64::MAX, u64::MAX);
-            for s in self.entries(node) {
-                let b = &self.boxes[s];
+            for i in 0..self.len_of(node) {
+                let b = self.entry_box(node, i);
                 let key = (b.enlargement(&bx), b.volume());
                 if key < best_key {
                     best_key = key;
-                    best = s;
+                    best = i;
                 }
             }
-            node = self.ids[best];
+            node = self.id_at(node, best);
         }
         self.push_entry(node, bx, id);
         self.adjust_upwards(node);
@@ -234,7 +321,7 @@ impl RTree {
     /// Splits overflowing nodes and tightens boxes from `node` up to the root.
     fn adjust_upwards(&mut self, mut node: u32) {
         loop {
-            let sibling = if usize::from(self.count[node as usize]) > self.max_entries {
+            let sibling = if self.len_of(node) > self.max_entries {
                 Some(self.split(node))
             } else {
                 None
@@ -253,45 +340,42 @@ impl RTree {
                 return;
             }
             let parent = self.parent[node as usize];
-            let s = self.slot_of_child(parent, node);
-            let tight = self.node_box(node).unwrap_or(self.boxes[s]);
-            let changed = tight != self.boxes[s];
-            self.boxes[s] = tight;
+            let i = self.index_of_child(parent, node);
+            let old = self.entry_box(parent, i);
+            let tight = self.node_box(node).unwrap_or(old);
+            self.set_entry_box(parent, i, tight);
             if let Some(sibling) = sibling {
                 if let Some(b) = self.node_box(sibling) {
                     self.push_entry(parent, b, sibling);
                 }
-            } else if !changed {
+            } else if tight == old {
                 return;
             }
             node = parent;
         }
     }
 
-    /// Removes `item` stored with box `bx`; returns whether it was found (Guttman Delete:
+    /// Removes `item`; returns its box, `None` when it is not in the tree (Guttman Delete:
     /// FindLeaf, remove, CondenseTree, shorten the tree).
-    pub fn remove(&mut self, item: u32, bx: &KeyBox) -> bool {
-        let Some((leaf, slot)) = self.find_leaf(self.root, item, bx) else {
-            return false;
-        };
-        let i = slot - self.slot(leaf, 0);
+    pub fn remove(&mut self, item: u32) -> Option<KeyBox> {
+        let bx = self.item_box(item)?;
+        let (leaf, i) = self.find_leaf(self.root, item, &bx)?;
         self.remove_slot(leaf, i);
         self.len -= 1;
         self.condense(leaf);
-        true
+        Some(bx)
     }
 
     fn find_leaf(&self, node: u32, item: u32, bx: &KeyBox) -> Option<(u32, usize)> {
-        let range = self.entries(node);
+        let n = self.len_of(node);
         if self.level[node as usize] == 0 {
-            return range
-                .into_iter()
-                .find(|&s| self.ids[s] == item && self.boxes[s] == *bx)
-                .map(|s| (node, s));
+            return (0..n)
+                .find(|&i| self.id_at(node, i) == item)
+                .map(|i| (node, i));
         }
-        for s in range {
-            if self.boxes[s].contains_box(bx) {
-                if let Some(found) = self.find_leaf(self.ids[s], item, bx) {
+        for i in 0..n {
+            if self.entry_box(node, i).contains_box(bx) {
+                if let Some(found) = self.find_leaf(self.id_at(node, i), item, bx) {
                     return Some(found);
                 }
             }
@@ -305,16 +389,16 @@ impl RTree {
         let mut node = leaf;
         while node != self.root {
             let parent = self.parent[node as usize];
-            let s = self.slot_of_child(parent, node);
-            if usize::from(self.count[node as usize]) < self.min_entries {
-                self.remove_slot(parent, s - self.slot(parent, 0));
+            let i = self.index_of_child(parent, node);
+            if self.len_of(node) < self.min_entries {
+                self.remove_slot(parent, i);
                 let level = self.level[node as usize];
-                for e in self.entries(node) {
-                    orphans.push((self.boxes[e], self.ids[e], level));
+                for e in 0..self.len_of(node) {
+                    orphans.push((self.entry_box(node, e), self.id_at(node, e), level));
                 }
                 self.free_node(node);
             } else if let Some(b) = self.node_box(node) {
-                self.boxes[s] = b;
+                self.set_entry_box(parent, i, b);
             }
             node = parent;
         }
@@ -333,9 +417,8 @@ impl RTree {
 
     /// Re-inserts every item below `node` (at `level`) as a leaf entry and frees the nodes.
     fn reinsert_items_of(&mut self, node: u32, level: u8) {
-        let entries: Vec<(KeyBox, u32)> = self
-            .entries(node)
-            .map(|s| (self.boxes[s], self.ids[s]))
+        let entries: Vec<(KeyBox, u32)> = (0..self.len_of(node))
+            .map(|i| (self.entry_box(node, i), self.id_at(node, i)))
             .collect();
         self.free_node(node);
         for (bx, id) in entries {
@@ -349,13 +432,18 @@ impl RTree {
 
     /// Makes the only child of an inner root the new root (repeatedly).
     fn shorten(&mut self) {
-        while self.level[self.root as usize] > 0 && self.count[self.root as usize] <= 1 {
+        while self.level[self.root as usize] > 0 && self.len_of(self.root) <= 1 {
             let old = self.root;
-            if self.count[old as usize] == 0 {
+            if self.len_of(old) == 0 {
+                // An empty inner root becomes an empty leaf node.
                 self.level[old as usize] = 0;
+                let block = std::mem::replace(&mut self.box_block[old as usize], NONE);
+                if block != NONE {
+                    self.free_blocks.push(block);
+                }
                 return;
             }
-            self.root = self.ids[self.slot(old, 0)];
+            self.root = self.id_at(old, 0);
             self.parent[self.root as usize] = NONE;
             self.free_node(old);
         }
@@ -369,12 +457,14 @@ impl RTree {
 
     fn find_containing_in(&self, node: u32, key: Key) -> Option<(u32, KeyBox)> {
         let leaf = self.level[node as usize] == 0;
-        for s in self.entries(node) {
-            if self.boxes[s].contains_key(key) {
+        for i in 0..self.len_of(node) {
+            let b = self.entry_box(node, i);
+            if b.contains_key(key) {
+                let id = self.id_at(node, i);
                 if leaf {
-                    return Some((self.ids[s], self.boxes[s]));
+                    return Some((id, b));
                 }
-                if let Some(found) = self.find_containing_in(self.ids[s], key) {
+                if let Some(found) = self.find_containing_in(id, key) {
                     return Some(found);
                 }
             }
@@ -389,12 +479,13 @@ impl RTree {
 
     fn intersecting_in(&self, node: u32, query: &KeyBox, visit: &mut impl FnMut(u32, &KeyBox)) {
         let leaf = self.level[node as usize] == 0;
-        for s in self.entries(node) {
-            if self.boxes[s].intersects(query) {
+        for i in 0..self.len_of(node) {
+            let b = self.entry_box(node, i);
+            if b.intersects(query) {
                 if leaf {
-                    visit(self.ids[s], &self.boxes[s]);
+                    visit(self.id_at(node, i), &b);
                 } else {
-                    self.intersecting_in(self.ids[s], query, visit);
+                    self.intersecting_in(self.id_at(node, i), query, visit);
                 }
             }
         }
@@ -407,11 +498,12 @@ impl RTree {
 
     fn items_in(&self, node: u32, visit: &mut impl FnMut(u32, &KeyBox)) {
         let leaf = self.level[node as usize] == 0;
-        for s in self.entries(node) {
+        for i in 0..self.len_of(node) {
+            let id = self.id_at(node, i);
             if leaf {
-                visit(self.ids[s], &self.boxes[s]);
+                visit(id, &self.item_boxes[id as usize]);
             } else {
-                self.items_in(self.ids[s], visit);
+                self.items_in(id, visit);
             }
         }
     }
@@ -436,7 +528,7 @@ impl RTree {
     }
 
     fn check_node(&self, node: u32, items: &mut usize) -> Result<(), String> {
-        let count = usize::from(self.count[node as usize]);
+        let count = self.len_of(node);
         if count > self.max_entries {
             return Err(format!("node {node} holds {count} > M entries"));
         }
@@ -444,19 +536,24 @@ impl RTree {
             return Err(format!("node {node} holds {count} < d entries"));
         }
         let level = self.level[node as usize];
-        for s in self.entries(node) {
+        if (level > 0) != (self.box_block[node as usize] != NONE) {
+            return Err(format!(
+                "node {node} at level {level} has the wrong box storage"
+            ));
+        }
+        for i in 0..count {
             if level == 0 {
                 *items += 1;
                 continue;
             }
-            let child = self.ids[s];
+            let child = self.id_at(node, i);
             if self.parent[child as usize] != node {
                 return Err(format!("child {child} does not point back to {node}"));
             }
             if self.level[child as usize] + 1 != level {
                 return Err(format!("child {child} is not one level below {node}"));
             }
-            if self.node_box(child) != Some(self.boxes[s]) {
+            if self.node_box(child) != Some(self.entry_box(node, i)) {
                 return Err(format!("box of child {child} in node {node} is not tight"));
             }
             self.check_node(child, items)?;

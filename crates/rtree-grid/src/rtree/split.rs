@@ -13,8 +13,8 @@ impl RTree {
     pub(super) fn split(&mut self, node: u32) -> u32 {
         let mut entries = std::mem::take(&mut self.scratch);
         entries.clear();
-        for s in self.entries(node) {
-            entries.push((self.boxes[s], self.ids[s]));
+        for i in 0..self.len_of(node) {
+            entries.push((self.entry_box(node, i), self.id_at(node, i)));
         }
         let n = entries.len();
         // PickSeeds.

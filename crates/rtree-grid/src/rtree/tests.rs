@@ -56,7 +56,7 @@ proptest! {
         let mut kept = Vec::new();
         for (i, &(x, y, z)) in cells.iter().enumerate() {
             if remove_mask[i] {
-                prop_assert!(tree.remove(i as u32, &cube(x, y, z)));
+                prop_assert_eq!(tree.remove(i as u32), Some(cube(x, y, z)));
                 tree.check_invariants().map_err(TestCaseError::fail)?;
             } else {
                 kept.push((i as u32, cube(x, y, z)));

@@ -1,0 +1,186 @@
+//! The scans of the comparison, as OctoMap scan graphs (written to `target/eval/octomap/`).
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use nalgebra::Point3;
+use raypath_geometry::{PointCloud, Pose3};
+use raypath_io::kitti::KittiSequence;
+use raypath_io::octomap::{ScanGraph, ScanNode, write_graph_file};
+
+use super::super::EvalContext;
+
+/// One data set: its scans and the graph file holding them.
+pub struct Dataset {
+    /// Short name.
+    pub name: String,
+    /// What it is.
+    pub about: String,
+    /// The scans.
+    pub graph: ScanGraph,
+    /// The `.graph` file the OctoMap driver reads.
+    pub path: PathBuf,
+    /// Query points (world frame) for the classification agreement.
+    pub queries: Vec<Point3<f64>>,
+    /// The query file.
+    pub queries_path: PathBuf,
+}
+
+fn node(id: u32, world_from_sensor: Pose3, points: Vec<Point3<f32>>) -> ScanNode {
+    ScanNode {
+        id,
+        world_from_sensor,
+        points: PointCloud::from_points(points),
+    }
+}
+
+/// The real `scan.dat` (sensor at the origin), every `stride`-th point, inserted `repeat`
+/// times (a static sensor scanning a static scene: cells reach the clamping bounds).
+pub fn scan_dat(ctx: &EvalContext, stride: usize, repeat: usize) -> Result<Option<Dataset>> {
+    let path = ctx.data("octomap/scan.dat.bz2");
+    if !path.exists() {
+        eprintln!(
+            "octomap: {} is absent, skipping the real scan",
+            path.display()
+        );
+        return Ok(None);
+    }
+    let cloud = raypath_io::xyz::read_xyz(&path)?;
+    let points: Vec<_> = (0..cloud.len())
+        .step_by(stride)
+        .map(|i| cloud.points[i])
+        .collect();
+    let n = points.len();
+    let graph = ScanGraph {
+        nodes: (0..repeat)
+            .map(|i| node(i as u32, Pose3::identity(), points.clone()))
+            .collect(),
+        edges: Vec::new(),
+    };
+    let name = if repeat == 1 {
+        "scan.dat".to_owned()
+    } else {
+        format!("scan.dat-x{repeat}")
+    };
+    finish(
+        ctx,
+        &name,
+        format!(
+            "real OctoMap sample scan, {n} points{}, sensor at the origin{}",
+            if stride > 1 {
+                format!(" (every {stride}th)")
+            } else {
+                String::new()
+            },
+            if repeat > 1 {
+                format!(", inserted {repeat} times (static sensor)")
+            } else {
+                String::new()
+            }
+        ),
+        graph,
+    )
+    .map(Some)
+}
+
+/// A simulated urban drive (HDL-64E, `raypath-sim` urban-kitti set): `scans` scans taken
+/// every `frame_step` frames, every `stride`-th point, in a REP-103 world frame.
+pub fn urban(
+    ctx: &EvalContext,
+    scans: usize,
+    frame_step: usize,
+    stride: usize,
+) -> Result<Option<Dataset>> {
+    let root = match crate::generate::ensure("urban-kitti", ctx.quick) {
+        Ok(root) => root,
+        Err(error) => {
+            eprintln!("octomap: skipping the urban drive: {error:#}");
+            return Ok(None);
+        }
+    };
+    let sequence = KittiSequence::open(&root.join("sequences/00"))?;
+    let cam_poses = sequence.poses()?;
+    let calib = sequence.calib()?.context("urban-kitti has no calib.txt")?;
+    let cam0_from_velo = calib.cam0_from_velo().context("calib without Tr")?;
+    let flu = raypath_io::kitti::flu_from_camera();
+    let mut nodes = Vec::new();
+    for (i, file) in sequence
+        .scan_files
+        .iter()
+        .step_by(frame_step)
+        .take(scans)
+        .enumerate()
+    {
+        let Some(world_from_cam0) = cam_poses.get(file.frame as usize) else {
+            continue;
+        };
+        let world_from_velo = flu * *world_from_cam0 * cam0_from_velo;
+        let cloud = raypath_io::kitti::read_velodyne(&file.path)?;
+        let points: Vec<_> = (0..cloud.len())
+            .step_by(stride)
+            .filter(|&j| cloud.is_valid(j))
+            .map(|j| cloud.points[j])
+            .collect();
+        nodes.push(node(i as u32, world_from_velo, points));
+    }
+    let graph = ScanGraph {
+        nodes,
+        edges: Vec::new(),
+    };
+    let about = format!(
+        "simulated urban drive (raypath-sim urban-kitti, HDL-64E): {} scans {} frames apart, {} points{}",
+        graph.nodes.len(),
+        frame_step,
+        graph.num_points(),
+        if stride > 1 {
+            format!(" (every {stride}th point)")
+        } else {
+            String::new()
+        }
+    );
+    finish(ctx, "urban", about, graph).map(Some)
+}
+
+/// Writes the graph and draws query points: per scan, points at random fractions
+/// `t ∈ [0, 1.05]` of random beams (free space, the surfaces and just behind them).
+fn finish(ctx: &EvalContext, name: &str, about: String, graph: ScanGraph) -> Result<Dataset> {
+    let dir = ctx.workspace_root.join("target/eval/octomap");
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    let path = dir.join(format!("{name}.graph"));
+    write_graph_file(&path, &graph)?;
+    let mut state = 0x1234_5678_9abc_def0u64;
+    let mut next = move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let per_scan = 20_000 / graph.nodes.len().max(1);
+    let mut queries = Vec::new();
+    for n in &graph.nodes {
+        if n.points.is_empty() {
+            continue;
+        }
+        let origin = Point3::from(n.world_from_sensor.translation());
+        for _ in 0..per_scan {
+            let i = ((next() * n.points.len() as f64) as usize).min(n.points.len() - 1);
+            let end = n.world_from_sensor.transform_point(&n.points.point_f64(i));
+            let t = next() * 1.05;
+            queries.push(origin + (end - origin) * t);
+        }
+    }
+    let queries_path = dir.join(format!("{name}.queries.txt"));
+    let text: String = queries
+        .iter()
+        .map(|q| format!("{} {} {}\n", q.x, q.y, q.z))
+        .collect();
+    std::fs::write(&queries_path, text)?;
+    Ok(Dataset {
+        name: name.into(),
+        about,
+        graph,
+        path,
+        queries,
+        queries_path,
+    })
+}
