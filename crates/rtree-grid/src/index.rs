@@ -26,6 +26,15 @@ fn hash(key: Key) -> u64 {
 
 #[allow(dead_code)]
 impl LatticeIndex {
+    /// An empty table with room for `n` entries before it grows.
+    pub fn with_capacity(n: usize) -> Self {
+        let slots = ((n * 4).div_ceil(3) + 1).next_power_of_two().max(64);
+        Self {
+            slots: vec![EMPTY; slots],
+            len: 0,
+        }
+    }
+
     /// Number of indexed cells.
     pub fn len(&self) -> usize {
         self.len

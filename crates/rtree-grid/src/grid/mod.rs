@@ -304,6 +304,9 @@ impl RtreeGrid {
             }
         }
         self.scans += 1;
+        if self.free_cells.len() > 4096 && self.free_cells.len() * 2 > self.log_odds.len() {
+            self.compact();
+        }
         self.free_keys = free_keys;
         self.occupied_keys = occupied_keys;
         self.sample_keys = sample_keys;
@@ -458,8 +461,32 @@ impl RtreeGrid {
             + size_of::<Self>()
     }
 
-    /// Releases spare capacity (per-scan scratch and vector slack).
+    /// Renumbers the cells and rebuilds the arenas without the holes left by fusion
+    /// (`O(n)`; runs automatically after a scan once half the cell ids are dead).
+    pub fn compact(&mut self) {
+        let map = self.tree.compact();
+        let mut log_odds = vec![0.0f32; self.tree.len()];
+        for (old, &new) in map.iter().enumerate() {
+            if let (Some(slot), Some(&l)) = (log_odds.get_mut(new as usize), self.log_odds.get(old))
+            {
+                *slot = l;
+            }
+        }
+        self.log_odds = log_odds;
+        self.free_cells = Vec::new();
+        let mut index = LatticeIndex::with_capacity(self.tree.len() - self.fused_cells);
+        let tree = &self.tree;
+        tree.for_each_item(&mut |id, bx| {
+            if bx.volume() == 1 {
+                index.insert(bx.lo, id, Self::key_of_cell(tree));
+            }
+        });
+        self.index = index;
+    }
+
+    /// Compacts the map and releases spare capacity (per-scan scratch and vector slack).
     pub fn shrink_to_fit(&mut self) {
+        self.compact();
         self.tree.shrink_to_fit();
         self.log_odds.shrink_to_fit();
         self.free_cells.shrink_to_fit();

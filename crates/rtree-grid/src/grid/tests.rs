@@ -210,3 +210,44 @@ fn rejects_bad_parameters() {
         .is_err()
     );
 }
+
+#[test]
+fn compaction_keeps_the_map_and_frees_memory() {
+    let scan = scan_points(9, 2000);
+    let mut grid = RtreeGrid::new(GridConfig::with(0.25, 8, SensorModel::BeamBased)).unwrap();
+    for _ in 0..8 {
+        grid.insert_scan(&Point3::new(0.1, 0.2, 0.3), &scan);
+    }
+    let before = grid.stats();
+    let cuboids_before = {
+        let mut c: Vec<_> = grid
+            .cuboids()
+            .iter()
+            .map(|c| (c.keys.lo, c.keys.hi, c.occupied))
+            .collect();
+        c.sort_unstable();
+        c
+    };
+    let probes: Vec<_> = scan_points(10, 500).iter().map(|p| p * 0.9).collect();
+    let classes: Vec<_> = probes.iter().map(|p| grid.classify(p)).collect();
+    grid.shrink_to_fit();
+    check(&grid);
+    let after = grid.stats();
+    assert_eq!(
+        (after.leaves, after.base_cubes, after.fused_leaves),
+        (before.leaves, before.base_cubes, before.fused_leaves)
+    );
+    assert!(after.bytes < before.bytes);
+    let mut cuboids_after: Vec<_> = grid
+        .cuboids()
+        .iter()
+        .map(|c| (c.keys.lo, c.keys.hi, c.occupied))
+        .collect();
+    cuboids_after.sort_unstable();
+    assert_eq!(cuboids_after, cuboids_before);
+    let again: Vec<_> = probes.iter().map(|p| grid.classify(p)).collect();
+    assert_eq!(again, classes);
+    // And the map keeps working.
+    grid.insert_scan(&Point3::new(0.1, 0.2, 0.3), &scan);
+    check(&grid);
+}

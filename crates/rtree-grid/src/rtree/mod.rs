@@ -508,6 +508,66 @@ impl RTree {
         }
     }
 
+    /// Rebuilds the arena without holes: nodes renumbered depth first, items renumbered
+    /// `0 .. len` in tree order (spatially coherent). The tree's shape is unchanged. Returns
+    /// the map from old item id to new id (`u32::MAX` for ids not in the tree). `O(n)`.
+    pub fn compact(&mut self) -> Vec<u32> {
+        let mut out = Compacted {
+            ids: Vec::with_capacity(self.num_nodes() * self.cap),
+            count: Vec::with_capacity(self.num_nodes()),
+            parent: Vec::with_capacity(self.num_nodes()),
+            level: Vec::with_capacity(self.num_nodes()),
+            box_block: Vec::with_capacity(self.num_nodes()),
+            inner_boxes: Vec::new(),
+            item_boxes: Vec::with_capacity(self.len),
+        };
+        let mut item_map = vec![NONE; self.item_boxes.len()];
+        self.copy_node(self.root, NONE, &mut out, &mut item_map);
+        self.ids = out.ids;
+        self.count = out.count;
+        self.parent = out.parent;
+        self.level = out.level;
+        self.box_block = out.box_block;
+        self.inner_boxes = out.inner_boxes;
+        self.item_boxes = out.item_boxes;
+        self.free_nodes = Vec::new();
+        self.free_blocks = Vec::new();
+        self.root = 0;
+        item_map
+    }
+
+    fn copy_node(&self, old: u32, parent: u32, out: &mut Compacted, item_map: &mut [u32]) -> u32 {
+        let new = out.count.len() as u32;
+        let n = self.len_of(old);
+        let level = self.level[old as usize];
+        out.count.push(self.count[old as usize]);
+        out.parent.push(parent);
+        out.level.push(level);
+        out.ids.resize(out.ids.len() + self.cap, NONE);
+        if level > 0 {
+            let block = (out.inner_boxes.len() / self.cap) as u32;
+            let start = self.box_block[old as usize] as usize * self.cap;
+            out.inner_boxes
+                .extend_from_slice(&self.inner_boxes[start..start + self.cap]);
+            out.box_block.push(block);
+        } else {
+            out.box_block.push(NONE);
+        }
+        for i in 0..n {
+            let child = self.id_at(old, i);
+            let new_child = if level == 0 {
+                let id = out.item_boxes.len() as u32;
+                out.item_boxes.push(self.item_boxes[child as usize]);
+                item_map[child as usize] = id;
+                id
+            } else {
+                self.copy_node(child, new, out, item_map)
+            };
+            out.ids[new as usize * self.cap + i] = new_child;
+        }
+        new
+    }
+
     /// Checks the R-tree invariants: fill in `[d, M]` except at the root (an inner root holds
     /// at least two entries), every inner entry's box is the tight bounding box of its child,
     /// all leaf nodes at level 0 (equal depth), parent links and the item count.
@@ -560,4 +620,15 @@ impl RTree {
         }
         Ok(())
     }
+}
+
+/// The arrays of a compacted tree under construction.
+struct Compacted {
+    ids: Vec<u32>,
+    count: Vec<u8>,
+    parent: Vec<u32>,
+    level: Vec<u8>,
+    box_block: Vec<u32>,
+    inner_boxes: Vec<KeyBox>,
+    item_boxes: Vec<KeyBox>,
 }

@@ -63,6 +63,20 @@ proptest! {
             }
         }
         prop_assert_eq!(tree.len(), kept.len());
+        if remove_mask[299] {
+            let map = tree.compact();
+            tree.check_invariants().map_err(TestCaseError::fail)?;
+            prop_assert_eq!(tree.num_nodes(), tree.count.len());
+            for k in &mut kept {
+                k.0 = map[k.0 as usize];
+                prop_assert!(k.0 < tree.len() as u32);
+            }
+            // Inserting and removing still work after compaction.
+            let extra = cube(40, 40, 40);
+            tree.insert(tree.len() as u32, extra);
+            prop_assert_eq!(tree.remove(tree.len() as u32 - 1), Some(extra));
+            tree.check_invariants().map_err(TestCaseError::fail)?;
+        }
         for &(id, b) in &kept {
             prop_assert_eq!(tree.find_containing(b.lo), Some((id, b)));
         }
