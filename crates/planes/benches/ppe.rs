@@ -1,6 +1,7 @@
-//! Criterion benchmark: PPE on a 500 × 500 organized scan of a box room with 2 cm radial
-//! noise (synthetic, so it runs without data), and on the first generated SynPEB-style
-//! scan (σ = 2 cm) when `cargo xtask datasets generate` has written it.
+//! Criterion benchmark: PPE (preset `synpeb`, with its refinement rounds) on a 500 × 500
+//! organized scan of a box room with 2 cm radial noise (synthetic, so it runs without data),
+//! and PPE and the PEAC-style baseline on the first generated SynPEB-style scan (σ = 2 cm)
+//! when `cargo xtask datasets generate` has written it.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -8,7 +9,7 @@ use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use raypath_planes::{PpeParams, extract, extract_grid};
+use raypath_planes::{PeacParams, PpeParams, extract, extract_grid, peac};
 
 fn room(n: usize, sigma: f64) -> Vec<Vector3<f64>> {
     let mut rng = ChaCha8Rng::seed_from_u64(7);
@@ -48,6 +49,16 @@ fn bench(c: &mut Criterion) {
     {
         group.bench_function("synpeb_generated_500x500", |b| {
             b.iter(|| extract(&pcd.cloud, &params).unwrap())
+        });
+        let points: Vec<Vector3<f64>> = pcd
+            .cloud
+            .points
+            .iter()
+            .map(|p| p.coords.cast::<f64>())
+            .collect();
+        let peac_params = PeacParams::synpeb();
+        group.bench_function("peac_synpeb_generated_500x500", |b| {
+            b.iter(|| peac(&points, 500, 500, &peac_params).unwrap())
         });
     } else {
         eprintln!(

@@ -15,6 +15,16 @@
 //! candidates at the front of the queue are ever recomputed. A final pass re-evaluates
 //! every queued candidate before stopping (stale keys are not lower bounds).
 //!
+//! Merge candidates are queued once per pair of planes (again only with a smaller key),
+//! which keeps the queue near the number of boundary rays.
+//!
+//! Optional post-processing ([`PpeParams::refine_rounds`], not in the thesis): each round
+//! (1) moves every ray on a plane boundary to the adjacent plane with the least radial
+//! residual, (2) merges 4-adjacent planes while the increment stays within `e`, and (3)
+//! merges the pieces of one surface split by an occluder — plane `a` ends along a row or
+//! column, only rays in front of the joint plane of `a` and `b` follow, then `b` begins —
+//! while the increment stays within `e`. Each round costs O(K) plus the merges.
+//!
 //! Cost: seeding evaluates 17 tetrominoes per ray (parallel, rayon); every action costs
 //! O(1) solves plus O(log Q) queue operations; a merge relabels the smaller plane
 //! (O(K log K) relabelling in total). Final exact refits are O(K · iterations).
@@ -174,6 +184,9 @@ struct Cluster {
     error: f64,
     members: Vec<u32>,
     parent: u32,
+    /// Partners of the merge candidates queued for this plane, with the least queued key:
+    /// a merge is queued again only with a smaller key (keeps the heap small).
+    queued: Vec<(u32, f64)>,
 }
 
 struct State<'a> {
@@ -387,13 +400,39 @@ impl<'a> State<'a> {
                     self.heap.push(Entry { key, action });
                 }
             } else if lo != plane {
+                let queued = self.clusters[plane as usize]
+                    .queued
+                    .iter()
+                    .find(|q| q.0 == lo)
+                    .map(|q| q.1);
                 let key = self.mrg_increment(plane, lo);
-                if key.is_finite() {
-                    self.heap.push(Entry {
-                        key,
-                        action: Action::Merge { a: plane, b: lo },
-                    });
+                if key.is_finite() && queued.is_none_or(|q| key < q) {
+                    self.queue_merge(plane, lo, key);
                 }
+            }
+        }
+    }
+
+    /// Queues the merge of planes `a` and `b` with `key` and records it on both.
+    fn queue_merge(&mut self, a: u32, b: u32, key: f64) {
+        for (x, y) in [(a, b), (b, a)] {
+            let list = &mut self.clusters[x as usize].queued;
+            match list.iter_mut().find(|q| q.0 == y) {
+                Some(q) => q.1 = q.1.min(key),
+                None => list.push((y, key)),
+            }
+        }
+        self.heap.push(Entry {
+            key,
+            action: Action::Merge { a, b },
+        });
+    }
+
+    /// Forgets the queued merge of `a` and `b` (popped from the heap).
+    fn unqueue_merge(&mut self, a: u32, b: u32) {
+        for (x, y) in [(a, b), (b, a)] {
+            if let Some(cl) = self.clusters.get_mut(x as usize) {
+                cl.queued.retain(|q| q.0 != y);
             }
         }
     }
@@ -457,6 +496,16 @@ impl<'a> State<'a> {
             if fresh.is_empty() {
                 return;
             }
+            for cl in &mut self.clusters {
+                cl.queued.clear();
+            }
+            for e in &fresh {
+                if let Action::Merge { a, b } = e.action {
+                    for (x, y) in [(a, b), (b, a)] {
+                        self.clusters[x as usize].queued.push((y, e.key));
+                    }
+                }
+            }
             self.heap = BinaryHeap::from(fresh);
         }
     }
@@ -504,8 +553,10 @@ impl<'a> State<'a> {
             if self.plane_limit_reached() {
                 break;
             }
-            if let Action::Extend { point, .. } = entry.action {
-                self.pending[point as usize] = NONE;
+            match entry.action {
+                Action::Extend { point, .. } => self.pending[point as usize] = NONE,
+                Action::Merge { a, b } => self.unqueue_merge(a, b),
+                Action::Create { .. } => {}
             }
             let Some(current) = self.reevaluate(entry) else {
                 continue;
@@ -515,13 +566,16 @@ impl<'a> State<'a> {
             }
             let still_least =
                 current.key <= entry.key || self.peek_key().is_none_or(|next| current.key <= next);
-            if !still_least {
-                self.heap.push(current);
+            let stop = still_least && self.stop(current.key);
+            if !still_least || stop {
+                match current.action {
+                    Action::Merge { a, b } => self.queue_merge(a, b, current.key),
+                    _ => self.heap.push(current),
+                }
+                if stop {
+                    break;
+                }
                 continue;
-            }
-            if self.stop(current.key) {
-                self.heap.push(current);
-                break;
             }
             match current.action {
                 Action::Create { point, mask } => {
@@ -543,6 +597,7 @@ impl<'a> State<'a> {
             error: stats.error(),
             members: cells.iter().map(|&c| c as u32).collect(),
             parent: id,
+            queued: Vec::new(),
         });
         for &c in &cells {
             self.label[c] = id;
