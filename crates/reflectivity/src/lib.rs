@@ -15,6 +15,7 @@
 //! * [`ScanMatcher`]: Gauss–Newton over `(x, y, θ)` with the occupancy (plain Hector),
 //!   reflectivity (the thesis) or combined (its future work) residual, an optional odometry
 //!   prior, map updates after enough motion and the covariance `σ² H⁻¹` (§3.4.2).
+//! * [`export`]: PGM + YAML occupancy maps, reflectivity PNGs and TUM trajectories.
 //! * [`benchmark`]: reading CARMEN logs into scans, pairing raw and corrected scans, and the
 //!   relative-motion error of Kümmerle et al. (2009) plus the aligned absolute error.
 //!
@@ -58,6 +59,7 @@
 pub mod benchmark;
 mod calibration;
 mod error;
+pub mod export;
 mod grid;
 pub mod lut;
 mod map;
