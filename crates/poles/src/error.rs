@@ -23,6 +23,20 @@ pub enum PoleError {
         /// What is wrong.
         reason: String,
     },
+    /// Reading a sequence failed (the error names the file and the place).
+    #[error(transparent)]
+    Read(#[from] raypath_io::Error),
+    /// A sequence lacks what the operation needs.
+    #[error("{}: {reason}", path.display())]
+    Sequence {
+        /// The sequence directory.
+        path: PathBuf,
+        /// What is missing.
+        reason: String,
+    },
+    /// Trajectory evaluation failed.
+    #[error(transparent)]
+    Evaluation(#[from] raypath_localizer::LocalizerError),
     /// Reading or writing a file failed.
     #[error("{}: {source}", path.display())]
     Io {

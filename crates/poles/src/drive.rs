@@ -1,0 +1,247 @@
+//! A recorded drive in KITTI or NCLT layout: scan times, ground-truth and odometry sensor
+//! poses per scan, and the scans themselves (read one at a time).
+//!
+//! * **KITTI** (`…/sequences/NN/` or a directory with `velodyne/`, `poses.txt`, `times.txt`,
+//!   `calib.txt`): sensor poses `world_from_velo = velo_from_cam0 · world_from_cam0 ·
+//!   cam0_from_velo` (the velodyne frame of the first scan is the world frame, as the
+//!   semi-synthetic pole maps). KITTI has no odometry: the odometry track is the ground truth
+//!   (evaluations corrupt its increments).
+//! * **NCLT** (a session directory): scans from `velodyne_sync/` turned to REP-103 axes, the
+//!   ground truth and the integrated odometry (`odometry_mu_100hz.csv`) interpolated at the
+//!   scan times, in REP-103 frames (`NcltPose::world_from_body`; the body frame is the
+//!   velodyne frame in the simulated sessions — spec errata 24: no extrinsic applied).
+
+use std::path::{Path, PathBuf};
+
+use raypath_geometry::{PointCloud, Pose3};
+use raypath_io::kitti::{self, KittiSequence};
+use raypath_io::nclt::{self, NcltPose, NcltSession};
+use raypath_localizer::PoseTrack;
+
+use crate::error::{PoleError, Result};
+
+/// The layout a drive was read from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DriveFormat {
+    /// KITTI odometry layout.
+    Kitti,
+    /// NCLT session layout.
+    Nclt,
+}
+
+enum Source {
+    Kitti { sequence: KittiSequence },
+    Nclt { session: NcltSession },
+}
+
+/// A drive: per scan a time, a ground-truth sensor pose (when known) and an odometry pose.
+pub struct Drive {
+    /// The directory.
+    pub dir: PathBuf,
+    /// The layout.
+    pub format: DriveFormat,
+    /// Scan times, seconds (strictly increasing).
+    pub stamps_secs: Vec<f64>,
+    /// Ground-truth `world_from_sensor` per scan, when the drive has ground truth.
+    pub ground_truth: Option<Vec<Pose3>>,
+    /// Odometry `odom_from_sensor` per scan.
+    pub odometry: Vec<Pose3>,
+    /// Per scan: standard deviations `[x m, y m, yaw rad]` of the odometry increment from the
+    /// previous scan, when the drive states them (NCLT `odometry_cov.csv`).
+    pub odometry_std: Option<Vec<[f64; 3]>>,
+    source: Source,
+}
+
+impl Drive {
+    /// Opens a KITTI sequence or an NCLT session (detected from the directory contents).
+    pub fn open(dir: &Path) -> Result<Self> {
+        let has = |p: &str| dir.join(p).exists();
+        if has("velodyne") || has("poses.txt") || has("calib.txt") || has("times.txt") {
+            return Self::open_kitti(dir);
+        }
+        Self::open_nclt(dir)
+    }
+
+    fn open_kitti(dir: &Path) -> Result<Self> {
+        let sequence = KittiSequence::open(dir)?;
+        let missing = |what: &str| PoleError::Sequence {
+            path: dir.to_path_buf(),
+            reason: format!("the KITTI sequence has no {what}"),
+        };
+        if sequence.scan_files.is_empty() {
+            return Err(missing("velodyne scans"));
+        }
+        let times = sequence.times()?;
+        let cam0_from_velo = match sequence.calib()? {
+            Some(calib) => calib
+                .cam0_from_velo()
+                .ok_or_else(|| missing("Tr in calib.txt"))?,
+            None => return Err(missing("calib.txt")),
+        };
+        let poses = sequence.poses()?;
+        let world_from_velo = kitti::velodyne_poses_from_cam0(&poses, &cam0_from_velo);
+        let mut stamps = Vec::with_capacity(sequence.scan_files.len());
+        let mut gt = Vec::with_capacity(sequence.scan_files.len());
+        for file in &sequence.scan_files {
+            let frame = file.frame as usize;
+            let t = times
+                .get(frame)
+                .copied()
+                .ok_or_else(|| missing(&format!("time for frame {frame} in times.txt")))?;
+            stamps.push(t);
+            if let Some(p) = world_from_velo.get(frame) {
+                gt.push(*p);
+            }
+        }
+        check_increasing(dir, &stamps)?;
+        let ground_truth = (gt.len() == stamps.len()).then_some(gt);
+        let odometry = ground_truth.clone().ok_or_else(|| {
+            missing("pose for every scan in poses.txt (KITTI odometry comes from the poses)")
+        })?;
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            format: DriveFormat::Kitti,
+            stamps_secs: stamps,
+            ground_truth,
+            odometry,
+            odometry_std: None,
+            source: Source::Kitti { sequence },
+        })
+    }
+
+    fn open_nclt(dir: &Path) -> Result<Self> {
+        let session = NcltSession::open(dir)?;
+        let missing = |what: &str| PoleError::Sequence {
+            path: dir.to_path_buf(),
+            reason: format!("the NCLT session has no {what}"),
+        };
+        if session.sync_files.is_empty() {
+            return Err(missing("velodyne_sync scans"));
+        }
+        let stamps: Vec<f64> = session
+            .sync_files
+            .iter()
+            .map(|f| nclt::utime_to_secs(f.utime))
+            .collect();
+        check_increasing(dir, &stamps)?;
+        let track = |rows: &[NcltPose], what: &str| -> Result<PoseTrack<Pose3>> {
+            let mut stamps_secs = Vec::with_capacity(rows.len());
+            let mut poses = Vec::with_capacity(rows.len());
+            for r in rows {
+                let t = r.stamp_secs();
+                if stamps_secs.last().is_some_and(|&last| t <= last) {
+                    continue;
+                }
+                stamps_secs.push(t);
+                poses.push(r.world_from_body());
+            }
+            PoseTrack::from_parts(stamps_secs, poses).map_err(|e| PoleError::Sequence {
+                path: dir.to_path_buf(),
+                reason: format!("{what}: {e}"),
+            })
+        };
+        let sample = |track: &PoseTrack<Pose3>| -> Option<Vec<Pose3>> {
+            stamps.iter().map(|&t| track.pose_at(t).ok()).collect()
+        };
+        let ground_truth = match session.ground_truth_path {
+            Some(_) => sample(&track(&session.ground_truth()?.poses, "ground truth")?),
+            None => None,
+        };
+        let odometry = match session.odometry_path {
+            Some(_) => sample(&track(&session.odometry()?.poses, "odometry")?)
+                .ok_or_else(|| missing("odometry covering every scan time"))?,
+            None => return Err(missing("odometry_mu_100hz.csv")),
+        };
+        let odometry_std = match session.relative_odometry_cov_path {
+            Some(_) => {
+                let cov = session.relative_odometry_cov()?;
+                let times: Vec<f64> = cov
+                    .records
+                    .iter()
+                    .map(|r| nclt::utime_to_secs(r.utime))
+                    .collect();
+                (!cov.records.is_empty()).then(|| {
+                    stamps
+                        .iter()
+                        .map(|&t| {
+                            let k = times.partition_point(|&s| s < t).min(times.len() - 1);
+                            let m = &cov.records[k].matrix;
+                            [m[(0, 0)], m[(1, 1)], m[(5, 5)]].map(|v| v.max(0.0).sqrt())
+                        })
+                        .collect()
+                })
+            }
+            None => None,
+        };
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            format: DriveFormat::Nclt,
+            stamps_secs: stamps,
+            ground_truth,
+            odometry,
+            odometry_std,
+            source: Source::Nclt { session },
+        })
+    }
+
+    /// Number of scans.
+    pub fn len(&self) -> usize {
+        self.stamps_secs.len()
+    }
+
+    /// True when the drive has no scans.
+    pub fn is_empty(&self) -> bool {
+        self.stamps_secs.is_empty()
+    }
+
+    /// Reads scan `index` (points in the sensor frame, REP-103 axes).
+    pub fn scan(&self, index: usize) -> Result<PointCloud> {
+        let out_of_range = || PoleError::Sequence {
+            path: self.dir.clone(),
+            reason: format!("no scan {index}"),
+        };
+        match &self.source {
+            Source::Kitti { sequence } => {
+                let file = sequence.scan_files.get(index).ok_or_else(out_of_range)?;
+                Ok(kitti::read_velodyne(&file.path)?)
+            }
+            Source::Nclt { session } => {
+                let file = session.sync_files.get(index).ok_or_else(out_of_range)?;
+                let mut cloud = nclt::read_velodyne_sync(&file.path)?;
+                nclt::flu_from_frd(&mut cloud);
+                Ok(cloud)
+            }
+        }
+    }
+
+    /// Total number of points of all scans (from file sizes).
+    pub fn count_points(&self) -> Result<u64> {
+        Ok(match &self.source {
+            Source::Kitti { sequence } => sequence.count_points()?,
+            Source::Nclt { session } => session.count_points()?,
+        })
+    }
+
+    /// The ground truth, or an error naming the drive.
+    pub fn require_ground_truth(&self) -> Result<&[Pose3]> {
+        self.ground_truth
+            .as_deref()
+            .ok_or_else(|| PoleError::Sequence {
+                path: self.dir.clone(),
+                reason: "no ground-truth poses".into(),
+            })
+    }
+}
+
+fn check_increasing(dir: &Path, stamps: &[f64]) -> Result<()> {
+    if let Some(k) = stamps
+        .windows(2)
+        .position(|w| !(w[0].is_finite() && w[1].is_finite() && w[1] > w[0]))
+    {
+        return Err(PoleError::Sequence {
+            path: dir.to_path_buf(),
+            reason: format!("scan times are not strictly increasing at scan {}", k + 1),
+        });
+    }
+    Ok(())
+}
