@@ -99,7 +99,6 @@ impl RtreeGrid {
     /// fills `members` with them.
     fn slab_fuses(&self, slab: &KeyBox, occupied: bool, members: &mut Vec<u32>) -> bool {
         members.clear();
-        let mut ok = true;
         let mut volume = 0u64;
         let target = slab.volume();
         if target == 1 {
@@ -112,18 +111,33 @@ impl RtreeGrid {
                 _ => false,
             };
         }
-        self.tree.for_each_intersecting(slab, &mut |id, bx| {
-            if !ok {
-                return;
+        // Fail fast on the slab's corner cubes when they are unfused cells of the wrong
+        // state (one hash probe each, before any tree walk).
+        for corner in 0..8u8 {
+            let key = [0, 1, 2].map(|a| {
+                if corner & (1 << a) != 0 {
+                    slab.hi[a]
+                } else {
+                    slab.lo[a]
+                }
+            });
+            if let Some(id) = self.index.get(key, Self::key_of_cell(&self.tree)) {
+                if self.is_clamped(self.log_odds[id as usize]) != Some(occupied) {
+                    return false;
+                }
+            } else if self.fused_cells == 0 {
+                return false; // unknown space
             }
+        }
+        let ok = self.tree.for_each_intersecting_while(slab, &mut |id, bx| {
             if !slab.contains_box(bx)
                 || self.is_clamped(self.log_odds[id as usize]) != Some(occupied)
             {
-                ok = false;
-                return;
+                return false;
             }
             volume += bx.volume();
             members.push(id);
+            true
         });
         ok && volume == target
     }

@@ -92,6 +92,7 @@ pub struct RtreeGrid {
     sample_keys: Vec<u64>,
     touched_fused: Vec<(u32, bool)>,
     selected: Vec<u32>,
+    recent: ray::RecentKeys,
 }
 
 /// Slack when comparing a log-odds with a clamping bound.
@@ -149,6 +150,7 @@ impl RtreeGrid {
             sample_keys: Vec::new(),
             touched_fused: Vec::new(),
             selected: Vec::new(),
+            recent: ray::RecentKeys::new(),
         })
     }
 
@@ -216,6 +218,8 @@ impl RtreeGrid {
         free_keys.clear();
         occupied_keys.clear();
         sample_keys.clear();
+        let mut recent = std::mem::replace(&mut self.recent, ray::RecentKeys { slots: Vec::new() });
+        recent.clear();
         let mut rng = ray::SplitMix(self.config.seed ^ self.scans.wrapping_mul(0x9E37_79B9));
         for p in points_m {
             let mut end = [p.x, p.y, p.z];
@@ -243,7 +247,11 @@ impl RtreeGrid {
                 }
             }
             if beam {
-                ray::ray_keys(origin, end, r, &mut free_keys);
+                ray::ray_keys_with(origin, end, r, |k| {
+                    if recent.insert(k) {
+                        free_keys.push(k);
+                    }
+                });
                 if let Some(spacing) = spacing {
                     let n = (len.min(self.config.max_range_m.unwrap_or(f64::INFINITY)) / spacing)
                         .ceil() as usize;
@@ -261,8 +269,11 @@ impl RtreeGrid {
                 }
             }
         }
+        self.recent = recent;
         occupied_keys.sort_unstable();
         occupied_keys.dedup();
+        sample_keys.sort_unstable();
+        sample_keys.dedup();
         free_keys.sort_unstable();
         free_keys.dedup();
         // Occupied wins: drop free keys that are also hit (both lists are sorted).

@@ -12,6 +12,18 @@ use crate::key::{KEY_OFFSET, key_of, pack};
 /// Appends the packed keys of the cubes the segment `origin → end` crosses before the cube
 /// of `end`.
 pub(crate) fn ray_keys(origin: [f64; 3], end: [f64; 3], resolution_m: f64, out: &mut Vec<u64>) {
+    ray_keys_with(origin, end, resolution_m, |k| out.push(k));
+}
+
+/// Calls `push` with the packed key of every cube the segment `origin → end` crosses before
+/// the cube of `end`.
+#[inline]
+pub(crate) fn ray_keys_with(
+    origin: [f64; 3],
+    end: [f64; 3],
+    resolution_m: f64,
+    mut push: impl FnMut(u64),
+) {
     let (Some(start), Some(stop)) = (key_of(origin, resolution_m), key_of(end, resolution_m))
     else {
         return;
@@ -47,7 +59,7 @@ pub(crate) fn ray_keys(origin: [f64; 3], end: [f64; 3], resolution_m: f64, out: 
         }
     }
     let max_steps: i32 = (0..3).map(|a| (target[a] - current[a]).abs()).sum::<i32>() + 3;
-    out.push(pack(start));
+    push(pack(start));
     for _ in 0..max_steps {
         let a = if t_max[0] < t_max[1] {
             if t_max[0] < t_max[2] { 0 } else { 2 }
@@ -65,7 +77,43 @@ pub(crate) fn ray_keys(origin: [f64; 3], end: [f64; 3], resolution_m: f64, out: 
         if dist > length || !(0..=65535).contains(&current[a]) {
             return;
         }
-        out.push(pack(current.map(|c| c as u16)));
+        push(pack(current.map(|c| c as u16)));
+    }
+}
+
+/// A direct-mapped cache of recently emitted keys: neighbouring beams of a scan cross the
+/// same cubes near the sensor, so most repeats are dropped before the per-scan sort.
+#[derive(Clone, Debug)]
+pub(crate) struct RecentKeys {
+    pub(crate) slots: Vec<u64>,
+}
+
+impl RecentKeys {
+    const BITS: u32 = 14;
+
+    /// An empty cache.
+    pub(crate) fn new() -> Self {
+        Self {
+            slots: vec![u64::MAX; 1 << Self::BITS],
+        }
+    }
+
+    /// Forgets everything.
+    pub(crate) fn clear(&mut self) {
+        self.slots.fill(u64::MAX);
+    }
+
+    /// Whether `key` is new (and remembers it).
+    #[inline]
+    pub(crate) fn insert(&mut self, key: u64) -> bool {
+        let i = (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - Self::BITS)) as usize;
+        let slot = &mut self.slots[i];
+        if *slot == key {
+            false
+        } else {
+            *slot = key;
+            true
+        }
     }
 }
 

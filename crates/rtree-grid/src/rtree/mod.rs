@@ -302,24 +302,32 @@ impl RTree {
     fn insert_at_level(&mut self, bx: KeyBox, id: u32, level: u8) {
         let mut node = self.root;
         while self.level[node as usize] > level {
+            // ChooseSubtree: least enlargement, ties to the smaller volume.
+            let start = self.box_block[node as usize] as usize * self.cap;
+            let boxes = &self.inner_boxes[start..start + self.len_of(node)];
             let mut best = 0;
             let mut best_key = (u64::MAX, u64::MAX);
-            for i in 0..self.len_of(node) {
-                let b = self.entry_box(node, i);
-                let key = (b.enlargement(&bx), b.volume());
-                if key < best_key {
-                    best_key = key;
+            for (i, b) in boxes.iter().enumerate() {
+                let volume = b.volume();
+                let enlargement = if b.contains_box(&bx) {
+                    0
+                } else {
+                    b.union(&bx).volume() - volume
+                };
+                if (enlargement, volume) < best_key {
+                    best_key = (enlargement, volume);
                     best = i;
                 }
             }
             node = self.id_at(node, best);
         }
         self.push_entry(node, bx, id);
-        self.adjust_upwards(node);
+        self.adjust_upwards(node, bx);
     }
 
-    /// Splits overflowing nodes and tightens boxes from `node` up to the root.
-    fn adjust_upwards(&mut self, mut node: u32) {
+    /// Splits overflowing nodes and enlarges the boxes from `node` up to the root after
+    /// `added` was put into `node`'s subtree.
+    fn adjust_upwards(&mut self, mut node: u32, added: KeyBox) {
         loop {
             let sibling = if self.len_of(node) > self.max_entries {
                 Some(self.split(node))
@@ -342,14 +350,19 @@ impl RTree {
             let parent = self.parent[node as usize];
             let i = self.index_of_child(parent, node);
             let old = self.entry_box(parent, i);
-            let tight = self.node_box(node).unwrap_or(old);
-            self.set_entry_box(parent, i, tight);
             if let Some(sibling) = sibling {
+                let tight = self.node_box(node).unwrap_or(old);
+                self.set_entry_box(parent, i, tight);
                 if let Some(b) = self.node_box(sibling) {
                     self.push_entry(parent, b, sibling);
                 }
-            } else if tight == old {
-                return;
+            } else {
+                // Without a split the node's box only grows by the added box.
+                let grown = old.union(&added);
+                if grown == old {
+                    return;
+                }
+                self.set_entry_box(parent, i, grown);
             }
             node = parent;
         }
@@ -474,21 +487,43 @@ impl RTree {
 
     /// Calls `visit(item, box)` for every item whose box shares a base cube with `query`.
     pub fn for_each_intersecting(&self, query: &KeyBox, visit: &mut impl FnMut(u32, &KeyBox)) {
-        self.intersecting_in(self.root, query, visit);
+        self.intersecting_in(self.root, query, &mut |id, b| {
+            visit(id, b);
+            true
+        });
     }
 
-    fn intersecting_in(&self, node: u32, query: &KeyBox, visit: &mut impl FnMut(u32, &KeyBox)) {
+    /// Like [`for_each_intersecting`](Self::for_each_intersecting), but stops as soon as
+    /// `visit` returns `false`; returns whether the walk ran to the end.
+    pub fn for_each_intersecting_while(
+        &self,
+        query: &KeyBox,
+        visit: &mut impl FnMut(u32, &KeyBox) -> bool,
+    ) -> bool {
+        self.intersecting_in(self.root, query, visit)
+    }
+
+    fn intersecting_in(
+        &self,
+        node: u32,
+        query: &KeyBox,
+        visit: &mut impl FnMut(u32, &KeyBox) -> bool,
+    ) -> bool {
         let leaf = self.level[node as usize] == 0;
         for i in 0..self.len_of(node) {
             let b = self.entry_box(node, i);
             if b.intersects(query) {
-                if leaf {
-                    visit(self.id_at(node, i), &b);
+                let go_on = if leaf {
+                    visit(self.id_at(node, i), &b)
                 } else {
-                    self.intersecting_in(self.id_at(node, i), query, visit);
+                    self.intersecting_in(self.id_at(node, i), query, visit)
+                };
+                if !go_on {
+                    return false;
                 }
             }
         }
+        true
     }
 
     /// Calls `visit(item, box)` for every item, in tree order.
