@@ -71,7 +71,9 @@ pub fn write_occupancy_map(level: &GridLevel, prefix: &Path) -> Result<(usize, u
     let res = level.resolution_m();
     let origin = level.origin();
     let mut yaml = String::new();
-    let name = pgm.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    let name = pgm
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
     let _ = writeln!(yaml, "image: {name}");
     let _ = writeln!(yaml, "resolution: {res}");
     let _ = writeln!(
@@ -107,9 +109,9 @@ pub fn write_reflectivity_png(level: &GridLevel, path: &Path) -> Result<bool> {
     let mut img = image::GrayImage::new(w as u32, h as u32);
     for (row, j) in (j0..j1).rev().enumerate() {
         for (col, i) in (i0..i1).enumerate() {
-            let v = level
-                .cell_reflectivity(i, j)
-                .map_or(0, |(m, _)| (255.0 * (m / top).clamp(0.0, 1.0)).round() as u8);
+            let v = level.cell_reflectivity(i, j).map_or(0, |(m, _)| {
+                (255.0 * (m / top).clamp(0.0, 1.0)).round() as u8
+            });
             img.put_pixel(col as u32, row as u32, image::Luma([v]));
         }
     }
