@@ -238,3 +238,140 @@ fn bad_input_exits_2_with_file_and_place() {
     let out = raypath(&["scan-match", log.to_str().unwrap(), "--mode", "nope"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// Ray cast in the room of [`range`] returning range, incidence angle and the hit point.
+fn cast(x: f64, y: f64, a: f64) -> (f64, f64, [f64; 2]) {
+    let r = range(x, y, a);
+    let (px, py) = (x + r * a.cos(), y + r * a.sin());
+    // The normal of the face hit: the coordinate that sits on a wall or pillar face.
+    let on = |v: f64, w: f64| (v - w).abs() < 1e-6;
+    let normal = if on(px, 4.0) || on(px, -3.0) || on(px, 1.0) || on(px, 1.5) {
+        [1.0, 0.0]
+    } else {
+        [0.0, 1.0]
+    };
+    let alpha = (a.cos() * normal[0] + a.sin() * normal[1])
+        .abs()
+        .clamp(0.0, 1.0)
+        .acos();
+    (r, alpha, [px, py])
+}
+
+/// Reference intensity: a near-range drop and a range-dependent angular fall-off.
+fn intensity(reflectivity: f64, r: f64, alpha: f64) -> f64 {
+    let h = 4.0 * r * r / ((r * r + 1.0) * (r * r + 1.0));
+    800.0 * reflectivity * h * alpha.cos().powf(1.0 + 0.1 * r)
+}
+
+#[test]
+fn reflectivity_mode_on_a_log_with_remissions() {
+    use raypath_geometry::{Pose2, Scan2};
+    use raypath_io::carmen::{CarmenWriter, LaserKind, LaserMessage};
+
+    let dir = tempfile::tempdir().unwrap();
+    // Calibration samples of the reference surface (ρ = 1).
+    let csv = dir.path().join("ref.csv");
+    let mut f = std::fs::File::create(&csv).unwrap();
+    for i in 0..60 {
+        for j in 0..18 {
+            let (r, a) = (0.2 + 0.12 * i as f64, (j as f64 * 5.0).to_radians());
+            writeln!(f, "{r},{a},{}", intensity(1.0, r, a)).unwrap();
+        }
+    }
+    drop(f);
+    let lut = dir.path().join("lut.json");
+    json_of(&raypath(&[
+        "calibrate-intensity",
+        csv.to_str().unwrap(),
+        "--out",
+        lut.to_str().unwrap(),
+        "--json",
+    ]));
+    // A ROBOTLASER1 log with remissions; walls striped 0.3 / 0.9 every 0.5 m.
+    let log = dir.path().join("refl.log");
+    let mut w = CarmenWriter::create(&log).unwrap();
+    for k in 0..40 {
+        let t = k as f64 * 0.05;
+        let pose = Pose2::new(
+            -1.5 + t,
+            -0.5 + 0.3 * (t * 1.2).sin(),
+            0.3 * (t * 0.8).sin(),
+        );
+        let (mut ranges, mut remissions) = (Vec::new(), Vec::new());
+        for i in 0..180 {
+            let a = pose.theta() - PI / 2.0 + i as f64 * PI / 180.0;
+            let (r, alpha, p) = cast(pose.x(), pose.y(), a);
+            let rho = if ((p[0] + p[1] + 10.0) / 0.5).floor() as i64 % 2 == 0 {
+                0.3
+            } else {
+                0.9
+            };
+            ranges.push(r);
+            remissions.push(intensity(rho, r, alpha));
+        }
+        let scan = Scan2 {
+            angle_min_rad: -PI / 2.0,
+            angle_increment_rad: PI / 180.0,
+            max_range_m: 30.0,
+            ranges,
+            intensities: Some(remissions),
+        };
+        w.laser(&LaserMessage {
+            kind: LaserKind::RobotLaser1,
+            scan,
+            world_from_laser: pose,
+            world_from_robot: pose,
+            velocities: None,
+            robot_laser: None,
+            ipc_timestamp_secs: 10.0 + t,
+            hostname: "sim".into(),
+            logger_timestamp_secs: t,
+            line: 0,
+        })
+        .unwrap();
+    }
+    w.finish().unwrap();
+    let prefix = dir.path().join("m");
+    let corrected = dir.path().join("corrected.log");
+    for mode in ["reflectivity", "combined"] {
+        let doc = json_of(&raypath(&[
+            "scan-match",
+            log.to_str().unwrap(),
+            "--mode",
+            mode,
+            "--lut",
+            lut.to_str().unwrap(),
+            "--ground-truth",
+            log.to_str().unwrap(),
+            "--map",
+            prefix.to_str().unwrap(),
+            "--corrected-log",
+            corrected.to_str().unwrap(),
+            "--json",
+        ]));
+        assert_eq!(doc["mode"], mode);
+        assert_eq!(doc["scans"], 40);
+        let ate = doc["errors"]["aligned"]["position_m"]["max"]
+            .as_f64()
+            .unwrap();
+        assert!(ate < 0.06, "{mode}: aligned error {ate}");
+    }
+    let png = std::fs::read(dir.path().join("m-reflectivity.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n") && png.len() > 100);
+    // The corrected log reads back with the estimated poses (the first at the origin).
+    let again = raypath(&[
+        "scan-match",
+        corrected.to_str().unwrap(),
+        "--scans",
+        "1",
+        "--json",
+    ]);
+    assert!(again.status.success());
+    let text = std::fs::read_to_string(&corrected).unwrap();
+    assert_eq!(
+        text.lines()
+            .filter(|l| l.starts_with("ROBOTLASER1"))
+            .count(),
+        40
+    );
+}

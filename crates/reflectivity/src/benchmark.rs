@@ -40,6 +40,8 @@ pub struct LogScan {
     pub logger_timestamp_secs: f64,
     /// 1-based line number in the log.
     pub line: u64,
+    /// The message type the scan came from.
+    pub kind: LaserKind,
 }
 
 /// Reads the front-laser scans of a CARMEN log (module docs).
@@ -55,6 +57,7 @@ pub fn read_laser_log(path: &Path) -> Result<Vec<LogScan>> {
                 ipc_timestamp_secs: m.ipc_timestamp_secs,
                 logger_timestamp_secs: m.logger_timestamp_secs,
                 line: m.line,
+                kind: m.kind,
             };
             match m.kind {
                 LaserKind::Front => front.push(s),

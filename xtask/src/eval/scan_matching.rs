@@ -23,6 +23,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use raypath_geometry::Pose2;
+use raypath_io::carmen::LaserKind;
 use raypath_reflectivity::benchmark::{
     AlignedErrors, LogScan, RelativeErrors, aligned_errors, consecutive_relations, pair_by_ranges,
     read_laser_log, relative_errors, run_matcher,
@@ -359,6 +360,7 @@ fn run_failure_case(
                 ipc_timestamp_secs: k as f64 / rate_hz,
                 logger_timestamp_secs: k as f64 / rate_hz,
                 line: k as u64 + 1,
+                kind: LaserKind::RobotLaser1,
             })
             .collect()
     };

@@ -7,7 +7,9 @@
 //! `PREFIX.pgm` + `PREFIX.yaml` (ROS map_server) and, when the map has reflectivity,
 //! `PREFIX-reflectivity.png`; `--ground-truth LOG` scores the trajectory against a
 //! corrected log (scans paired by identical readings): relative-motion error over consecutive
-//! reference scans (Kümmerle et al. 2009) and the error after rigid alignment.
+//! reference scans (Kümmerle et al. 2009) and the error after rigid alignment;
+//! `--corrected-log FILE` a copy of the log whose matched laser messages carry the estimated
+//! poses (messages after `--scans` keep theirs).
 //!
 //! `--json` prints `{"scans", "time_s", "scans_per_s", "mode", "map_updates", "beams",
 //! "errors"}` (`errors` only with `--ground-truth`: `pairs`, `relative`, `aligned`).
@@ -16,9 +18,10 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use raypath_geometry::Pose2;
+use raypath_io::carmen::{CarmenReader, CarmenWriter, Record};
 use raypath_reflectivity::benchmark::{
-    aligned_errors, consecutive_relations, pair_by_ranges, read_laser_log, relative_errors,
-    run_matcher,
+    LogScan, aligned_errors, consecutive_relations, pair_by_ranges, read_laser_log,
+    relative_errors, run_matcher,
 };
 use raypath_reflectivity::export::{tum_lines, write_occupancy_map, write_reflectivity_png};
 use raypath_reflectivity::{
@@ -67,6 +70,9 @@ pub struct Args {
     /// Readings at or above this range are not used, metres.
     #[arg(long, default_value_t = 30.0, value_name = "M")]
     pub max_range: f64,
+    /// Write a copy of the log whose laser poses (and robot poses) are the estimates.
+    #[arg(long, value_name = "FILE")]
+    pub corrected_log: Option<PathBuf>,
     /// Process only the first N scans.
     #[arg(long, value_name = "N")]
     pub scans: Option<usize>,
@@ -144,6 +150,37 @@ fn read_lut(args: &Args, mode: ResidualMode) -> Result<Option<IntensityCorrectio
     Ok(Some(model))
 }
 
+/// Copies the log with the estimated poses in the laser messages that were matched (the
+/// first `poses.len()` messages of the matched kind); other lines are re-written as read.
+fn write_corrected_log(
+    args: &Args,
+    path: &std::path::Path,
+    scans: &[LogScan],
+    poses: &[Pose2],
+) -> Result<(), Failure> {
+    let kind = scans.first().map(|s| s.kind);
+    let reader = CarmenReader::open(&args.log).map_err(|e| Failure::input(e, args.json))?;
+    let mut writer = CarmenWriter::create(path).map_err(|e| failure(e, args.json))?;
+    let mut k = 0;
+    for record in reader {
+        let mut record = record.map_err(|e| Failure::input(e, args.json))?;
+        if let Record::Laser(m) = &mut record
+            && Some(m.kind) == kind
+        {
+            if let Some(pose) = poses.get(k) {
+                // The estimate is the laser's pose; keep the logged laser-on-robot offset.
+                let robot_from_laser = m.world_from_robot.inverse() * m.world_from_laser;
+                m.world_from_laser = *pose;
+                m.world_from_robot = *pose * robot_from_laser.inverse();
+            }
+            k += 1;
+        }
+        writer.record(&record).map_err(|e| failure(e, args.json))?;
+    }
+    writer.finish().map_err(|e| failure(e, args.json))?;
+    Ok(())
+}
+
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let config = config(args)?;
@@ -185,6 +222,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         );
         std::fs::write(out, text)
             .map_err(|e| failure(format!("{}: {e}", out.display()), args.json))?;
+    }
+    if let Some(path) = &args.corrected_log {
+        write_corrected_log(args, path, &scans, &poses)?;
     }
     let mut reflectivity_png = None;
     if let Some(prefix) = &args.map {
