@@ -13,9 +13,11 @@ pub enum SensorModel {
 /// Which cells start a fusion after a scan (Khan 2017, §2.5.2, Fig. 2.6).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Selection {
-    /// The thesis' selection: every end-point cell plus cells sampled at random along each
-    /// beam, `k = ⌈len / (spacing · r)⌉` samples per beam (the thesis gives no number; the
-    /// spec's default spacing is 10 base cubes). The end-point model uses end points only.
+    /// The thesis' selection: every end-point cell plus cells sampled at random along the
+    /// beams — here each de-duplicated traversed cell with probability `1 / spacing`, the
+    /// expected `len / (spacing · r)` samples per beam of the spec (the thesis gives no
+    /// number; the spec's default spacing is 10 base cubes). The end-point model uses end
+    /// points only.
     BeamSamples {
         /// Mean distance between samples, in base cubes (s ≥ 1).
         spacing_cells: f64,

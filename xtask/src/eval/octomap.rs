@@ -21,7 +21,7 @@ use std::fmt::Write;
 use std::time::Instant;
 
 use anyhow::Result;
-use raypath_rtree_grid::{GridConfig, Occupancy, RtreeGrid, SensorModel};
+use raypath_rtree_grid::{GridConfig, Occupancy, RtreeGrid, Selection, SensorModel};
 use serde_json::json;
 
 use super::{EvalContext, EvalReport};
@@ -45,7 +45,11 @@ struct OursRun {
 }
 
 fn run_ours(set: &Dataset, resolution_m: f64, m: usize, model: SensorModel) -> Result<OursRun> {
-    let mut grid = RtreeGrid::new(GridConfig::with(resolution_m, m, model))?;
+    run_config(set, GridConfig::with(resolution_m, m, model))
+}
+
+fn run_config(set: &Dataset, config: GridConfig) -> Result<OursRun> {
+    let mut grid = RtreeGrid::new(config)?;
     let started = Instant::now();
     for node in &set.graph.nodes {
         grid.insert_cloud(&node.world_from_sensor, &node.points);
@@ -114,9 +118,9 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         sets.extend(data::scan_dat(ctx, stride, repeat)?);
     }
     let urban = if ctx.quick {
-        data::urban(ctx, 5, 2, 8)?
+        data::urban(ctx, 5, 1, 8)?
     } else {
-        data::urban(ctx, 20, 2, 2)?
+        data::urban(ctx, 30, 1, 4)?
     };
     sets.extend(urban);
     let driver = peer::build(&ctx.workspace_root);
@@ -154,6 +158,17 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     let (mut ours_insert_02, mut peer_insert_02) = (0.0, 0.0);
     let (mut ours_bytes_02, mut peer_bytes_02) = (0usize, 0usize);
     let mut reduction_02: Option<(String, f64)> = None;
+    let mut variants = Table::new([
+        "data",
+        "variant",
+        "leaves",
+        "fused",
+        "bytes",
+        "insert [µs/pt]",
+        "leaf reduction",
+        "insert ratio",
+        "agree (all / known)",
+    ]);
     for set in &sets {
         let points = set.graph.num_points().max(1) as f64;
         for &r in resolutions {
@@ -174,6 +189,57 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
                     Err(_) => None,
                 };
                 bar.inc(1);
+                if (r - 0.2).abs() < 1e-9 && !endpoint {
+                    let base = GridConfig::with(r, 8, model);
+                    let cases = [
+                        (
+                            "no fusion (plain grid in the R-tree)",
+                            GridConfig {
+                                fusion: false,
+                                ..base
+                            },
+                        ),
+                        ("thesis selection (default)", base),
+                        (
+                            "fuse from every updated cell",
+                            GridConfig {
+                                selection: Selection::UpdatedCells,
+                                ..base
+                            },
+                        ),
+                        (
+                            "split fused cells on unclamp",
+                            GridConfig {
+                                split_on_unclamp: true,
+                                ..base
+                            },
+                        ),
+                    ];
+                    for (label, config) in cases {
+                        let ours = run_config(set, config)?;
+                        variants.row([
+                            set.name.clone(),
+                            label.to_owned(),
+                            ours.leaves.to_string(),
+                            ours.fused.to_string(),
+                            ours.bytes.to_string(),
+                            fmt_num(ours.insert_secs / points * 1e6, 3),
+                            peer.as_ref().map_or("—".into(), |p| {
+                                format!(
+                                    "{:.1} %",
+                                    100.0 * (1.0 - ours.leaves as f64 / p.leaves as f64)
+                                )
+                            }),
+                            peer.as_ref().map_or("—".into(), |p| {
+                                fmt_num(ours.insert_secs / p.insert_secs, 2)
+                            }),
+                            peer.as_ref().map_or("—".into(), |p| {
+                                let (a, k) = agreement(&ours.classes, &p.classes);
+                                format!("{a:.3} / {k:.3}")
+                            }),
+                        ]);
+                    }
+                }
                 for &m in orders {
                     let ours = run_ours(set, r, m, model)?;
                     bar.inc(1);
@@ -300,6 +366,13 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         sets.first().map_or(0, |s| s.queries.len())
     )?;
     md.push_str(&table.to_markdown());
+    writeln!(
+        md,
+        "\n## Variants (beam-based, r = 0.2 m, M = 8)\n\nThe thesis fuses only clamped cells, \
+         starting from end-point cells and cells sampled along the beams; the variants show \
+         what the selection and the optional split-back (the thesis' future work) change.\n"
+    )?;
+    md.push_str(&variants.to_markdown());
     writeln!(
         md,
         "\n## Notes\n\n\

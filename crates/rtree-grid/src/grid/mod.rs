@@ -89,7 +89,6 @@ pub struct RtreeGrid {
     scans: u64,
     free_keys: Vec<u64>,
     occupied_keys: Vec<u64>,
-    sample_keys: Vec<u64>,
     touched_fused: Vec<(u32, bool)>,
     selected: Vec<u32>,
     recent: ray::RecentKeys,
@@ -147,7 +146,6 @@ impl RtreeGrid {
             scans: 0,
             free_keys: Vec::new(),
             occupied_keys: Vec::new(),
-            sample_keys: Vec::new(),
             touched_fused: Vec::new(),
             selected: Vec::new(),
             recent: ray::RecentKeys::new(),
@@ -206,18 +204,18 @@ impl RtreeGrid {
         let r = self.config.resolution_m;
         let origin = [origin_m.x, origin_m.y, origin_m.z];
         let beam = self.config.model == SensorModel::BeamBased;
-        let spacing = match self.config.selection {
-            Selection::BeamSamples { spacing_cells } if beam && self.config.fusion => {
-                Some(spacing_cells * r)
-            }
-            _ => None,
+        // §2.F.1: end-point cells always start fusions; each cell a beam traversed does so
+        // with probability 1 / spacing (the thesis samples ⌈len / (s·r)⌉ random cells per beam:
+        // the same expected number, drawn from the de-duplicated traversed cells).
+        let sample_probability = match self.config.selection {
+            _ if !beam || !self.config.fusion => 0.0,
+            Selection::BeamSamples { spacing_cells } => 1.0 / spacing_cells,
+            Selection::UpdatedCells => 1.0,
         };
         let mut free_keys = std::mem::take(&mut self.free_keys);
         let mut occupied_keys = std::mem::take(&mut self.occupied_keys);
-        let mut sample_keys = std::mem::take(&mut self.sample_keys);
         free_keys.clear();
         occupied_keys.clear();
-        sample_keys.clear();
         let mut recent = std::mem::replace(&mut self.recent, ray::RecentKeys { slots: Vec::new() });
         recent.clear();
         let mut rng = ray::SplitMix(self.config.seed ^ self.scans.wrapping_mul(0x9E37_79B9));
@@ -252,28 +250,11 @@ impl RtreeGrid {
                         free_keys.push(k);
                     }
                 });
-                if let Some(spacing) = spacing {
-                    let n = (len.min(self.config.max_range_m.unwrap_or(f64::INFINITY)) / spacing)
-                        .ceil() as usize;
-                    for _ in 0..n {
-                        let t = rng.next_f64();
-                        let q = [
-                            origin[0] + (end[0] - origin[0]) * t,
-                            origin[1] + (end[1] - origin[1]) * t,
-                            origin[2] + (end[2] - origin[2]) * t,
-                        ];
-                        if let Some(k) = key_of(q, r) {
-                            sample_keys.push(pack(k));
-                        }
-                    }
-                }
             }
         }
         self.recent = recent;
         occupied_keys.sort_unstable();
         occupied_keys.dedup();
-        sample_keys.sort_unstable();
-        sample_keys.dedup();
         free_keys.sort_unstable();
         free_keys.dedup();
         // Occupied wins: drop free keys that are also hit (both lists are sorted).
@@ -290,24 +271,21 @@ impl RtreeGrid {
         update.occupied_keys = occupied_keys.len();
         let mut selected = std::mem::take(&mut self.selected);
         selected.clear();
-        let collect_all = matches!(self.config.selection, Selection::UpdatedCells);
+        let fusion = self.config.fusion;
         for (keys, hit) in [(&free_keys, false), (&occupied_keys, true)] {
             for &packed in keys.iter() {
                 let id = self.update_key(unpack(packed), hit, &mut update);
-                if collect_all || hit {
-                    if let Some(id) = id {
-                        selected.push(id);
-                    }
+                let Some(id) = id else { continue };
+                let chosen = fusion
+                    && (hit || sample_probability >= 1.0 || rng.next_f64() < sample_probability);
+                // Only clamped cells can fuse (checked again when fusing).
+                if chosen && self.is_clamped(self.log_odds[id as usize]).is_some() {
+                    selected.push(id);
                 }
             }
         }
         self.apply_fused_updates();
-        if self.config.fusion {
-            for &packed in &sample_keys {
-                if let Some(id) = self.cell_id_of_key(unpack(packed)) {
-                    selected.push(id);
-                }
-            }
+        if fusion {
             selected.sort_unstable();
             selected.dedup();
             for &id in &selected {
@@ -320,7 +298,6 @@ impl RtreeGrid {
         }
         self.free_keys = free_keys;
         self.occupied_keys = occupied_keys;
-        self.sample_keys = sample_keys;
         self.selected = selected;
         update
     }
@@ -342,8 +319,8 @@ impl RtreeGrid {
         (log_odds + delta).clamp(self.l_min, self.l_max) // Eq. (2.7), clamped
     }
 
-    /// Applies one update to the cell holding `key` (creating it); returns the cell id for
-    /// base cubes, `None` for a fused cell (queued, updated once per scan).
+    /// Applies one update to the cell holding `key` (creating it) and returns the cell id;
+    /// updates of fused cells are queued and applied once per scan.
     fn update_key(&mut self, key: Key, hit: bool, update: &mut ScanUpdate) -> Option<u32> {
         if let Some(id) = self.index.get(key, Self::key_of_cell(&self.tree)) {
             let l = self.log_odds[id as usize];
@@ -361,7 +338,7 @@ impl RtreeGrid {
                     return self.update_key(key, hit, update);
                 }
                 self.touched_fused.push((id, hit));
-                return None;
+                return Some(id);
             }
         }
         let l = self.updated(0.0, hit);
@@ -503,7 +480,6 @@ impl RtreeGrid {
         self.free_cells.shrink_to_fit();
         self.free_keys = Vec::new();
         self.occupied_keys = Vec::new();
-        self.sample_keys = Vec::new();
         self.selected = Vec::new();
         self.touched_fused = Vec::new();
     }
