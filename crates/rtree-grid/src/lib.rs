@@ -67,6 +67,7 @@
 //! ```
 
 pub mod config;
+mod coverage;
 mod export;
 mod grid;
 mod index;

@@ -125,7 +125,7 @@ impl RtreeGrid {
                 if self.is_clamped(self.log_odds[id as usize]) != Some(occupied) {
                     return false;
                 }
-            } else if self.fused_cells == 0 {
+            } else if !self.coverage.may_contain(key) {
                 return false; // unknown space
             }
         }

@@ -10,6 +10,7 @@ use nalgebra::Point3;
 use raypath_geometry::{PointCloud, Pose3};
 
 use crate::config::{GridConfig, Selection, SensorModel, logit};
+use crate::coverage::FusedCoverage;
 use crate::index::LatticeIndex;
 use crate::key::{Key, KeyBox, key_of, pack, unpack};
 use crate::rtree::{OrderError, RTree};
@@ -81,6 +82,7 @@ pub struct RtreeGrid {
     free_cells: Vec<u32>,
     index: LatticeIndex,
     fused_cells: usize,
+    coverage: FusedCoverage,
     l_hit: f32,
     l_miss: f32,
     l_min: f32,
@@ -138,6 +140,7 @@ impl RtreeGrid {
             free_cells: Vec::new(),
             index: LatticeIndex::default(),
             fused_cells: 0,
+            coverage: FusedCoverage::default(),
             l_hit: logit(config.prob_hit) as f32,
             l_miss: logit(config.prob_miss) as f32,
             l_min: logit(config.clamp_min) as f32,
@@ -307,7 +310,7 @@ impl RtreeGrid {
         if let Some(id) = self.index.get(key, Self::key_of_cell(&self.tree)) {
             return Some(id);
         }
-        if self.fused_cells == 0 {
+        if !self.coverage.may_contain(key) {
             return None;
         }
         self.tree.find_containing(key).map(|(id, _)| id)
@@ -327,7 +330,7 @@ impl RtreeGrid {
             self.log_odds[id as usize] = self.updated(l, hit);
             return Some(id);
         }
-        if self.fused_cells > 0 {
+        if self.coverage.may_contain(key) {
             if let Some((id, bx)) = self.tree.find_containing(key) {
                 let l = self.log_odds[id as usize];
                 let leaves_clamp = self.is_clamped(l).is_some()
@@ -390,6 +393,7 @@ impl RtreeGrid {
             self.index.insert(bx.lo, id, Self::key_of_cell(&self.tree));
         } else {
             self.fused_cells += 1;
+            self.coverage.add(&bx);
         }
         id
     }
@@ -400,6 +404,7 @@ impl RtreeGrid {
             self.index.remove(cell.bx.lo, Self::key_of_cell(&self.tree));
         } else {
             self.fused_cells -= 1;
+            self.coverage.remove(&cell.bx);
         }
         self.tree.remove(id);
         self.log_odds[id as usize] = f32::NAN;
@@ -446,6 +451,7 @@ impl RtreeGrid {
             + self.log_odds.capacity() * size_of::<f32>()
             + self.free_cells.capacity() * 4
             + self.index.memory_bytes()
+            + self.coverage.memory_bytes()
             + size_of::<Self>()
     }
 
