@@ -86,6 +86,6 @@ impl FusedCoverage {
 
     /// Bytes of the table (capacity × entry, plus control bytes).
     pub(crate) fn memory_bytes(&self) -> usize {
-        self.blocks.capacity() * (std::mem::size_of::<(u64, u32)>() + 1)
+        self.blocks.capacity() * (size_of::<(u64, u32)>() + 1)
     }
 }
