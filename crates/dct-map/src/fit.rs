@@ -181,6 +181,23 @@ fn newton(
                 };
                 mu = mu.max(1e-12);
                 let old = eval.log_likelihood;
+                // The barrier terms ln g_k² curve away faster than the quadratic model: when
+                // the model was accurate, try longer steps along the same direction.
+                let (mut trial, mut ll) = (trial, ll);
+                if rho > 0.9 {
+                    let mut scale = 1.0;
+                    while scale < 16.0 {
+                        scale *= 2.0;
+                        let longer: Vec<f64> =
+                            a.iter().zip(&step).map(|(a, s)| a + scale * s).collect();
+                        let l2 = p.log_likelihood(&longer);
+                        report.evaluations += 1;
+                        if !(l2.is_finite() && l2 > ll) {
+                            break;
+                        }
+                        (trial, ll) = (longer, l2);
+                    }
+                }
                 a = trial;
                 eval = p.evaluate(&a);
                 report.evaluations += 1;

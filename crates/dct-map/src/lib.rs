@@ -63,6 +63,7 @@
 //! | [`derivatives`] | per-ray gradient and Hessian in the thesis's `B`/`C` notation |
 //! | [`GridRateMap`], [`initial_map`], [`DctMap::from_grid`], [`DctMap::to_rate_grid`] | the grid baseline (ch. 7) and conversions |
 //! | [`render`] | PNG of `p_ref = 1 − e^{−λ}` |
+//! | [`experiment`] | patch choice, ray draws, ground truth and the DCT-vs-grid comparison of Sec. 9.5 |
 //!
 //! ## Defaults and where they come from
 //!
@@ -88,6 +89,7 @@
 
 pub mod derivatives;
 mod error;
+pub mod experiment;
 mod fit;
 mod grid;
 mod map;
