@@ -2,9 +2,9 @@
 //! semi-synthetic KITTI drive (Schaefer 2020, §12.5, Table 12.2).
 //!
 //! * Data: `datasets/generated/semi-kitti` — simulated HDL-64E scans along the **real**
-//!   trajectory of KITTI odometry sequence 07 among its **real** poles (`raypath-sim`), and in
-//!   the full run also `urban-kitti` (a procedural street world). The other `kitti-poles`
-//!   sequences (00–06) are not simulated: one full semi-synthetic sequence is 2.6 GB of scans.
+//!   trajectory of KITTI odometry sequence 07 among its **real** poles (`raypath-sim`). The
+//!   other `kitti-poles` sequences (00–06) are not simulated: one full semi-synthetic
+//!   sequence is 2.6 GB of scans and ≈ 7 min of extraction here.
 //! * Protocol (as the thesis, `kittipoles.py`): local maps every 3 m over 5 m of trajectory
 //!   with the ground-truth poses, merged into the reference map; localization on the same
 //!   drive with 2000 particles, 3 m / ±5° initial spread, increments corrupted by
