@@ -15,24 +15,28 @@
 //! * **Own R-tree, not `rstar`.** The thesis needs the quadratic split, deletion with
 //!   Guttman's condense/re-insert of fused cells, and in-place updates of leaf payloads;
 //!   `rstar` implements the R*-tree (different split and forced re-insertion), has no
-//!   payload-in-place update by id and stores `f64`/generic envelopes. [`RTree`] is an
-//!   arena (flat vectors, `M + 1` entry slots per node, no per-node heap allocation) over
-//!   16-bit integer boxes ([`KeyBox`], 12 bytes), so a leaf entry costs 16 bytes.
-//! * **Payload outside the tree.** Cells are `(box, log-odds)` records of 16 bytes in an
-//!   arena; the tree stores their ids. Updating occupancy never touches the tree.
-//! * **O(1) updates of unfused cells.** A lattice index (open addressing, 4 bytes per slot)
-//!   maps a base-cube key to its cell, so a scan update is a hash probe, not an R-tree
-//!   descent; only keys missing from the index (new cells or cells inside fused cuboids)
-//!   search the tree.
-//! * **Batched scans.** A scan is traversed once into vectors of packed keys, sorted and
-//!   de-duplicated (occupied wins over free, OctoMap's `insertPointCloud` rule, our
-//!   decision §2.D), then applied; fused cells get at most one update per scan.
-//! * **Fusion only from selected cells**, as in the thesis (§2.F.1): end-point cells plus
-//!   cells sampled along each beam ([`Selection`]).
+//!   payload update by id and stores generic `f64` envelopes. [`RTree`] is an arena: flat
+//!   vectors with `M + 1` child slots per node, a box block per inner node, item boxes stored
+//!   once by item id — no per-node heap allocation; boxes are 16-bit lattice keys
+//!   ([`KeyBox`], 12 bytes).
+//! * **Payload outside the tree.** A cell is its box (in the tree) and a 4-byte log-odds
+//!   (in the grid); updating occupancy never touches the tree.
+//! * **O(1) updates of unfused cells.** A lattice index (open addressing, 4 bytes per slot,
+//!   load ≤ ¾) maps a base-cube key to its cell, so a scan update is a hash probe, not an
+//!   R-tree descent. Keys missing from it search the tree only in the 16³ blocks a fused
+//!   cell touches (a count per block), so new cells elsewhere cost one tree insertion.
+//! * **Batched scans.** A scan is traversed once (exact voxel traversal on the lattice) into
+//!   a vector of packed keys — a small direct-mapped cache drops the repeats of neighbouring
+//!   beams — then sorted and de-duplicated (occupied wins over free, OctoMap's
+//!   `insertPointCloud` rule, spec §2.D) and applied; fused cells get one update per scan.
+//! * **Fusion only from selected cells** (§2.F.1): end-point cells plus traversed cells drawn
+//!   at random ([`Selection`]); only clamped candidates are kept.
+//! * **Compaction.** Fusion frees cell ids and nodes; once half the ids are dead, an `O(n)`
+//!   pass renumbers cells in tree order and rebuilds the arenas ([`RtreeGrid::compact`]).
 //!
-//! Per scan with `n` beams crossing `c` distinct cubes: traversal `O(c)`, sorting
-//! `O(c log c)`, updates `O(c)` hash probes plus `O(log N)` tree work for each new cell, and
-//! fusion `O(|T| · (log N + k))` for `|T|` selected cells and `k` leaves per slab query.
+//! Per scan with `n` beams crossing `c` distinct cubes: traversal `O(Σ beam cells)`, sorting
+//! `O(c log c)`, updates `O(c)` hash probes plus `O(M log_d N)` per new cell, and fusion
+//! `O(|T| · (log N + k))` for `|T|` selected cells and `k` leaves per slab query.
 //!
 //! # Errata and decisions (spec §2.F.4 flags)
 //!
@@ -40,6 +44,10 @@
 //!   clamped with the polarity of `g_i` — coverage and non-overlap checks the thesis omits.
 //! * The fused probability is the equal-weight mean over the cells (g_i included).
 //! * Cells removed earlier in the same pass are skipped; + before − per axis.
+//! * Beam samples: each de-duplicated traversed cell is a candidate with probability
+//!   `1 / spacing` (the spec's `⌈len / (s·r)⌉` random positions per beam give the same
+//!   expected number; drawing from the traversed cells needs no extra look-ups).
+//! * Fused cells are updated as a whole, as in the thesis (unless split, below).
 //! * M and d were lost with the figure legends: M = 8, d = ⌈0.4·M⌉ by default.
 //! * Beams longer than [`GridConfig::max_range_m`] are cut and free only (OctoMap's rule).
 //! * Optional splitting of fused cells back into base cubes when an update would take them
