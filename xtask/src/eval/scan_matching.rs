@@ -366,11 +366,31 @@ fn run_failure_case(
     };
     let narrow = make_scans(60.0, 121);
     let wide = make_scans(90.0, 181);
-    let runs: [(&str, &[LogScan], ResidualMode); 4] = [
-        ("occupancy, ±60°", &narrow, ResidualMode::Occupancy),
-        ("reflectivity, ±60°", &narrow, ResidualMode::Reflectivity),
-        ("combined, ±60°", &narrow, ResidualMode::Combined),
-        ("occupancy, ±90° (control)", &wide, ResidualMode::Occupancy),
+    let runs: [(&str, &[LogScan], ResidualMode, Option<&str>); 4] = [
+        (
+            "occupancy, ±60°",
+            &narrow,
+            ResidualMode::Occupancy,
+            Some("room-occupancy-60"),
+        ),
+        (
+            "reflectivity, ±60°",
+            &narrow,
+            ResidualMode::Reflectivity,
+            None,
+        ),
+        (
+            "combined, ±60°",
+            &narrow,
+            ResidualMode::Combined,
+            Some("room-combined-60"),
+        ),
+        (
+            "occupancy, ±90° (control)",
+            &wide,
+            ResidualMode::Occupancy,
+            None,
+        ),
     ];
     let relations = consecutive_relations(truth.len());
     let mut table = Table::new([
@@ -383,7 +403,7 @@ fn run_failure_case(
         "scans/s",
     ]);
     let mut out = Vec::new();
-    for (label, scans, mode) in runs {
+    for (label, scans, mode, figure) in runs {
         let config = MatcherConfig {
             mode,
             map: MapConfig {
@@ -393,8 +413,19 @@ fn run_failure_case(
             ..MatcherConfig::default()
         };
         let t = Instant::now();
-        let (_, results) = run_matcher(scans, config, &PointFilter::default(), Some(lut), false)?;
+        let (matcher, results) =
+            run_matcher(scans, config, &PointFilter::default(), Some(lut), false)?;
         let seconds = t.elapsed().as_secs_f64();
+        if let (Some(file), Some(level)) = (figure, matcher.map().levels().first()) {
+            let dir = ctx.figure_dir(NAME)?;
+            write_occupancy_png(level, &dir.join(format!("{file}-occupancy.png")))?;
+            if mode != ResidualMode::Occupancy {
+                raypath_reflectivity::export::write_reflectivity_png(
+                    level,
+                    &dir.join(format!("{file}-reflectivity.png")),
+                )?;
+            }
+        }
         // The map frame starts at the first scan: express the estimate in the world frame.
         let start = truth.first().copied().unwrap_or_else(Pose2::identity);
         let est: Vec<Pose2> = results
@@ -437,7 +468,50 @@ fn run_failure_case(
         truth.len()
     );
     let _ = writeln!(md, "{}", table.to_markdown());
+    let _ = writeln!(
+        md,
+        "Maps (finest level, 5 cm) after the run: occupancy-only (left: the map smears where \
+         the position along a wall slid) and combined (right), and the combined run's mean \
+         reflectivity per cell (bottom; brighter = higher ϱ̄).\n\n\
+         ![occupancy-only map](scan-matching/room-occupancy-60-occupancy.png) \
+         ![combined map](scan-matching/room-combined-60-occupancy.png)\n\n\
+         ![reflectivity map](scan-matching/room-combined-60-reflectivity.png)\n"
+    );
     Ok(Value::Array(out))
+}
+
+/// Writes the occupancy of a level as a PNG (free white, occupied black, unknown grey),
+/// cropped to the observed cells.
+fn write_occupancy_png(
+    level: &raypath_reflectivity::GridLevel,
+    path: &std::path::Path,
+) -> Result<()> {
+    let (mut i0, mut j0, mut i1, mut j1) = (usize::MAX, usize::MAX, 0, 0);
+    for j in 0..level.height() {
+        for i in 0..level.width() {
+            if level.log_odds(i, j) != 0.0 {
+                (i0, j0, i1, j1) = (i0.min(i), j0.min(j), i1.max(i + 1), j1.max(j + 1));
+            }
+        }
+    }
+    if i1 == 0 {
+        return Ok(());
+    }
+    let mut img = image::GrayImage::new((i1 - i0) as u32, (j1 - j0) as u32);
+    for (row, j) in (j0..j1).rev().enumerate() {
+        for (col, i) in (i0..i1).enumerate() {
+            let l = level.log_odds(i, j);
+            let v = if l == 0.0 {
+                160
+            } else {
+                (255.0 * (1.0 - raypath_reflectivity::probability(l))) as u8
+            };
+            img.put_pixel(col as u32, row as u32, image::Luma([v]));
+        }
+    }
+    img.save(path)
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(())
 }
 
 /// Runs the evaluation.
@@ -476,6 +550,27 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     }
     let _ = writeln!(md, "{}", anchors.to_markdown());
     let real = run_real(ctx, &mut md)?;
+    let speeds: Vec<(String, f64)> = real
+        .as_array()
+        .map(|rows| {
+            rows.iter()
+                .filter_map(|r| {
+                    let sps = r["errors"]["scans_per_s"].as_f64()?;
+                    let label = format!("{} / {}", r["log"].as_str()?, r["method"].as_str()?);
+                    sps.is_finite().then_some((label, sps))
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    if let Some((slowest, sps)) = speeds.iter().min_by(|a, b| a.1.total_cmp(&b.1)) {
+        let _ = writeln!(
+            md,
+            "**Speed** (aim ≥ 200 scans/s for 180-beam scans at 5 cm): slowest run {slowest} \
+             at {sps:.0} scans/s (Intel has 180 beams; fr079 360, mit-csail 361), including map \
+             updates, under load from other jobs. `cargo bench -p raypath-reflectivity` measures \
+             the matcher alone on synthetic 180-beam scans.\n"
+        );
+    }
     let _ = writeln!(md, "## Intensity calibration (simulated, Khan Fig. 3.4)\n");
     let (calibration, lut) = run_calibration(ctx, &mut md)?;
     let _ = writeln!(md, "## Failure case (simulated, Khan Fig. 3.6)\n");
