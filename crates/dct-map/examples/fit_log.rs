@@ -27,7 +27,8 @@ fn main() {
     } else {
         Solver::TrustRegionNewton
     };
-    let (mapping, _) = draw_rays(&rays, &patch, &RangeLimits::default(), 10_000, 500, 9);
+    let count: usize = args.get(6).map_or(10_000, |s| s.parse().unwrap());
+    let (mapping, _) = draw_rays(&rays, &patch, &RangeLimits::default(), count, 500, 9);
     let shape = Shape { l: n, m: n };
     let t = Instant::now();
     let problem = FitProblem::new(patch.extent_m, shape, &mapping).unwrap();

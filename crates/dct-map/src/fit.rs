@@ -144,7 +144,7 @@ fn newton(
         let diag: Vec<f64> = (0..n).map(|i| h[i * n + i].abs()).collect();
         let dmax = diag.iter().copied().fold(0.0, f64::max).max(1e-300);
         if mu.is_nan() {
-            mu = 1e-4;
+            mu = 1e-9;
         }
         // Gradient of f = −LL.
         let gf: Vec<f64> = eval.gradient.iter().map(|g| -g).collect();
@@ -173,13 +173,13 @@ fn newton(
             let rho = actual / predicted.max(1e-300);
             if ll.is_finite() && actual > 0.0 && rho > 1e-4 {
                 mu *= if rho > 0.75 {
-                    1.0 / 3.0
+                    0.1
                 } else if rho < 0.25 {
                     2.0
                 } else {
                     1.0
                 };
-                mu = mu.max(1e-12);
+                mu = mu.max(1e-15);
                 let old = eval.log_likelihood;
                 // The barrier terms ln g_k² curve away faster than the quadratic model: when
                 // the model was accurate, try longer steps along the same direction.

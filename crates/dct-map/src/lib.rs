@@ -104,7 +104,7 @@ pub use error::DctError;
 pub use fit::{FitConfig, FitReport, Solver, fit};
 pub use grid::{GridRateMap, initial_map};
 pub use map::DctMap;
-pub use objective::{Evaluation, FitProblem};
+pub use objective::{Evaluation, FitProblem, RIDGE_FACTOR};
 pub use ray::{MapRay, Outcome, Patch, RangeLimits};
 pub use spectrum::{
     Shape, fill_product_matrix, product_matrix, product_matrix_times, self_convolution,

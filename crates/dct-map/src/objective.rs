@@ -34,7 +34,12 @@ pub struct FitProblem {
     /// Moments of each `sub` ray.
     subs: Vec<Vec<f64>>,
     rays: usize,
+    /// Weight `δ` of the ridge `−δ ‖a‖²` added to the log-likelihood.
+    ridge: f64,
 }
+
+/// Default ridge factor: `δ = RIDGE_FACTOR · max_i K_ii` (see [`FitProblem::set_ridge_factor`]).
+pub const RIDGE_FACTOR: f64 = 1e-10;
 
 /// Value, gradient (and optionally Hessian) of the log-likelihood at one point.
 #[derive(Clone, Debug)]
@@ -99,7 +104,10 @@ impl FitProblem {
             .map(|r| moments(shape, extent_m, &r.segment()))
             .collect();
         let k_total = product_matrix(shape, &t_total);
+        let n = shape.len();
+        let max_diag = (0..n).map(|i| k_total[i * n + i]).fold(0.0, f64::max);
         Ok(Self {
+            ridge: RIDGE_FACTOR * max_diag,
             shape,
             extent_m,
             t_total,
@@ -109,6 +117,26 @@ impl FitProblem {
             subs,
             rays: rays.len(),
         })
+    }
+
+    /// Sets the ridge to `factor · max_i K_ii` (`0` for the plain likelihood).
+    ///
+    /// The thesis optimizes the bare likelihood. With fewer rays than coefficients the Gram
+    /// matrix `K` has directions of near-zero curvature (coefficient combinations that live
+    /// where no ray passes), and along them the rounding error of `aᵀ K a` (relative
+    /// `~1e-16 ‖K‖ ‖a‖²`) can turn negative: the optimizer then "increases" the likelihood
+    /// without bound by growing `a`. A ridge `δ ‖a‖²` with `δ = 1e-10 · max K_ii`
+    /// ([`RIDGE_FACTOR`], a weak Gaussian prior far below any data term) removes that
+    /// numerical escape while changing well-posed fits negligibly.
+    pub fn set_ridge_factor(&mut self, factor: f64) {
+        let n = self.shape.len();
+        let max_diag = (0..n).map(|i| self.k_total[i * n + i]).fold(0.0, f64::max);
+        self.ridge = factor.max(0.0) * max_diag;
+    }
+
+    /// The ridge weight `δ` (log-likelihood `− δ ‖a‖²`).
+    pub fn ridge(&self) -> f64 {
+        self.ridge
     }
 
     /// The coefficient shape.
@@ -172,7 +200,7 @@ impl FitProblem {
                 })
                 .sum()
         };
-        let v = hits - quad + subs;
+        let v = hits - quad + subs - self.ridge * a.iter().map(|a| a * a).sum::<f64>();
         if v.is_nan() { f64::NEG_INFINITY } else { v }
     }
 
@@ -232,7 +260,7 @@ impl FitProblem {
                 gradient.iter_mut().zip(&kv).for_each(|(g, k)| *g += w * k);
             }
         }
-        let v = hits - quad + subs;
+        let v = hits - quad + subs - self.ridge * a.iter().map(|a| a * a).sum::<f64>();
         Evaluation {
             log_likelihood: if v.is_nan() { f64::NEG_INFINITY } else { v },
             gradient,
@@ -276,6 +304,9 @@ impl FitProblem {
             .collect();
         let mut h = vec![0.0; n * n];
         fill_product_matrix(self.shape, &sum, |i, j, v| h[i * n + j] = v);
+        for i in 0..n {
+            h[i * n + i] += 2.0 * self.ridge;
+        }
         if !self.subs.is_empty() {
             let b = self_convolution(self.shape, a);
             for t in &self.subs {

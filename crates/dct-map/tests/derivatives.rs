@@ -102,7 +102,8 @@ fn aggregated_objective_equals_the_sum_over_rays() {
             random_ray(&mut r, extent, outcome)
         })
         .collect();
-    let problem = FitProblem::new(extent, map.shape(), &rays).unwrap();
+    let mut problem = FitProblem::new(extent, map.shape(), &rays).unwrap();
+    problem.set_ridge_factor(0.0);
     let e = problem.evaluate(map.coefficients());
     let h = problem.negative_hessian(map.coefficients(), &e.amplitudes);
     let (mut ll, mut grad, mut hess) = (0.0, vec![0.0; n], vec![0.0; n * n]);
