@@ -120,7 +120,7 @@ impl ReflectionPrior {
     }
 
     /// Fits the prior to hit/miss counts (voxels with `h + m > 0` only).
-    pub fn estimate(hits: &[u32], misses: &[u32]) -> Self {
+    pub fn estimate(hits: &[u16], misses: &[u16]) -> Self {
         let (mut n, mut sum, mut sum_sq) = (0u64, 0.0f64, 0.0f64);
         for (&h, &m) in hits.iter().zip(misses) {
             let total = h as u64 + m as u64;

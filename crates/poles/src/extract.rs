@@ -70,7 +70,7 @@ pub fn occupancy(counts: &HitMissGrid, threshold: f64) -> (Vec<f32>, ReflectionP
             || OccupancyTable::new(prior, threshold),
             |table, ((o, h), m)| {
                 for ((o, &h), &m) in o.iter_mut().zip(h).zip(m) {
-                    *o = table.get(h, m);
+                    *o = table.get(h as u32, m as u32);
                 }
             },
         );

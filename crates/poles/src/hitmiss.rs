@@ -6,12 +6,13 @@ use nalgebra::{Point3, Unit};
 use rayon::prelude::*;
 use raypath_geometry::{Grid3, PointCloud, Pose3};
 
-/// Hit and miss counts per voxel of a [`Grid3`] (linear index, x fastest).
+/// Hit and miss counts per voxel of a [`Grid3`] (linear index, x fastest), saturating
+/// `u16` (half the memory traffic of `u32`; a voxel with 65535 misses is free anyway).
 #[derive(Clone, Debug, PartialEq)]
 pub struct HitMissGrid {
     grid: Grid3,
-    hits: Vec<u32>,
-    misses: Vec<u32>,
+    hits: Vec<u16>,
+    misses: Vec<u16>,
     rays: u64,
 }
 
@@ -33,12 +34,12 @@ impl HitMissGrid {
     }
 
     /// Hits per voxel.
-    pub fn hits(&self) -> &[u32] {
+    pub fn hits(&self) -> &[u16] {
         &self.hits
     }
 
     /// Misses per voxel.
-    pub fn misses(&self) -> &[u32] {
+    pub fn misses(&self) -> &[u16] {
         &self.misses
     }
 
@@ -84,11 +85,11 @@ impl HitMissGrid {
         let grid = &self.grid;
         let per_thread = items.len().div_ceil(threads).max(1);
         let max_sq = max_range_m * max_range_m;
-        let partials: Vec<(Vec<u32>, Vec<u32>, u64)> = items
+        let partials: Vec<(Vec<u16>, Vec<u16>, u64)> = items
             .par_chunks(per_thread)
             .map(|work| {
-                let mut hits = vec![0u32; n];
-                let mut misses = vec![0u32; n];
+                let mut hits = vec![0u16; n];
+                let mut misses = vec![0u16; n];
                 let mut rays = 0u64;
                 for &(s, start, end) in work {
                     let Some((pose, cloud)) = scans.get(s) else {
@@ -122,7 +123,7 @@ impl HitMissGrid {
     }
 }
 
-fn add_into(total: &mut [u32], part: &[u32]) {
+fn add_into(total: &mut [u16], part: &[u16]) {
     total
         .par_chunks_mut(1 << 16)
         .zip(part.par_chunks(1 << 16))
@@ -137,8 +138,8 @@ fn add_into(total: &mut [u32], part: &[u32]) {
 #[inline]
 fn trace(
     grid: &Grid3,
-    hits: &mut [u32],
-    misses: &mut [u32],
+    hits: &mut [u16],
+    misses: &mut [u16],
     origin: &Point3<f64>,
     endpoint: &Point3<f64>,
 ) {
@@ -181,7 +182,7 @@ mod tests {
         // A ray leaving the grid only misses.
         map.insert_ray(&Point3::new(0.5, 0.5, 0.5), &Point3::new(20.0, 0.5, 0.5));
         assert_eq!(map.misses()[9], 1);
-        assert_eq!(map.hits().iter().sum::<u32>(), 1);
+        assert_eq!(map.hits().iter().map(|&h| h as u32).sum::<u32>(), 1);
     }
 
     #[test]
