@@ -50,20 +50,21 @@ impl PpeParams {
     /// radial σ in cm), each from a grid search on the 10 generated training scans of its
     /// level maximizing the mean f (`cargo run --release -p raypath-planes --example
     /// ppe_scan -- --refine 3 --e E --lmax D datasets/generated/synpeb/train/<σ>/*.pcd`):
-    /// `√e` ∈ {0.06, 0.10, 0.14, 0.20, 0.28, 0.40} m and `d = l_max` ∈ {0.10, 0.20} m, on
-    /// the reference implementation's grids (`√e` in 2 cm steps, `d` in 2 cm steps up to
-    /// 20 cm), with 3 refinement rounds and planes of at least 10 rays; `d = 0.20 m` wins
-    /// at every level. Best mean f on the training split: 85.6, 84.0, 79.3, 69.7 and
-    /// 56.5 % (σ = 0, 0.5, 1, 2, 4 cm). The reference implementation's own values live in a
-    /// binary `paramppe.mat` the thesis does not print.
+    /// `√e` ∈ {0.06, 0.10, 0.14, 0.20, 0.28, 0.40} m (the reference implementation's grid
+    /// has `√e` in 2 cm steps) and `d = l_max` ∈ {0.10, 0.20} m for every `√e`, extended to
+    /// 0.30 and 0.40 m (beyond the reference grid's 20 cm) around the best `√e`; 3 refinement
+    /// rounds, planes of at least 10 rays; ties go to the larger `d`, then the larger `√e`.
+    /// Best mean f on the training split: 85.7, 84.5, 79.5, 71.2 and 57.3 % (σ = 0, 0.5, 1,
+    /// 2, 4 cm); the full grid is in `docs/results/synpeb.md`. The reference
+    /// implementation's own values live in a binary `paramppe.mat` the thesis does not print.
     pub fn synpeb_noise(level_cm: &str) -> Option<Self> {
         // (√e in m, l_max in m) per level.
         let (sqrt_e, l_max) = match level_cm {
-            "0.0" => (0.06, 0.20),
-            "0.5" => (0.06, 0.20),
-            "1.0" => (0.10, 0.20),
-            "2.0" => (0.20, 0.20),
-            "4.0" => (0.40, 0.20),
+            "0.0" => (0.06, 0.40),
+            "0.5" => (0.10, 0.40),
+            "1.0" => (0.10, 0.40),
+            "2.0" => (0.20, 0.40),
+            "4.0" => (0.28, 0.30),
             _ => return None,
         };
         Some(Self {

@@ -415,26 +415,40 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
 /// How the presets were chosen (offline grid search on the training split).
 const GRID: &str = "Grid search (as the thesis did, on the 10 training scans of each level; \
 `cargo run --release -p raypath-planes --example ppe_scan -- --refine 3 --e E --lmax D \
-datasets/generated/synpeb/train/<σ>/*.pcd`), mean f [%] on the training split; the preset takes \
-the best cell of its level (bold):
+datasets/generated/synpeb/train/<σ>/*.pcd`), mean f [%] on the training split. d = 0.10 and \
+0.20 m (the top of the reference implementation's d grid) for every √e; d = 0.30 and 0.40 m \
+only around the best √e (– = not run). The preset takes the best cell of its level (bold; \
+ties to the larger d, then the larger √e):
 
-| √e [m] | σ 0.0: d 0.10 | σ 0.0: d 0.20 | σ 0.5: d 0.10 | σ 0.5: d 0.20 | σ 1.0: d 0.10 | σ 1.0: d 0.20 | σ 2.0: d 0.10 | σ 2.0: d 0.20 | σ 4.0: d 0.10 | σ 4.0: d 0.20 |
-| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |
-| 0.06 | 80.8 | **85.6** | 80.4 | **84.0** | 75.3 | 76.9 | 5.0 | 7.4 | 0.2 | 0.2 |
-| 0.10 | 80.4 | 85.4 | 80.4 | 83.6 | 76.4 | **79.3** | 59.2 | 61.9 | 0.8 | 1.0 |
-| 0.14 | 78.4 | 82.1 | 79.3 | 82.3 | 75.4 | 78.9 | 67.3 | 69.2 | 5.4 | 9.4 |
-| 0.20 | 73.1 | 77.3 | 73.1 | 76.8 | 72.1 | 75.5 | 67.1 | **69.7** | 39.7 | 46.2 |
-| 0.28 | 70.4 | 75.2 | 69.1 | 73.3 | 68.8 | 72.7 | 66.6 | 68.5 | 54.5 | 55.3 |
-| 0.40 | 67.0 | 70.9 | 66.1 | 70.0 | 66.4 | 67.7 | 62.5 | 65.7 | 54.0 | **56.5** |
+| σ [cm] | d [m] | √e 0.06 | √e 0.10 | √e 0.14 | √e 0.20 | √e 0.28 | √e 0.40 |
+| --- | --- | --- | --- | --- | --- | --- | --- |
+| 0.0 | 0.10 | 80.4 | 79.8 | 78.1 | 72.6 | 70.0 | 66.8 |
+| 0.0 | 0.20 | 84.8 | 84.1 | 82.1 | 77.5 | 75.3 | 70.7 |
+| 0.0 | 0.30 | 85.0 | 84.9 | – | – | – | – |
+| 0.0 | 0.40 | **85.7** | 85.3 | – | – | – | – |
+| 0.5 | 0.10 | 80.4 | 80.4 | 79.3 | 73.1 | 69.1 | 66.1 |
+| 0.5 | 0.20 | 84.0 | 83.6 | 82.3 | 76.8 | 73.3 | 70.0 |
+| 0.5 | 0.30 | 84.1 | 84.2 | – | – | – | – |
+| 0.5 | 0.40 | 84.5 | **84.5** | – | – | – | – |
+| 1.0 | 0.10 | 74.7 | 76.6 | 75.4 | 72.4 | 69.1 | 66.7 |
+| 1.0 | 0.20 | 76.9 | 79.4 | 78.7 | 75.6 | 72.7 | 67.7 |
+| 1.0 | 0.30 | – | 79.4 | 79.5 | – | – | – |
+| 1.0 | 0.40 | – | **79.5** | 79.2 | – | – | – |
+| 2.0 | 0.10 | 4.9 | 60.8 | 66.7 | 66.9 | 66.5 | 62.1 |
+| 2.0 | 0.20 | 6.8 | 61.9 | 70.0 | 69.7 | 68.5 | 65.9 |
+| 2.0 | 0.30 | – | – | 70.3 | 70.0 | 69.8 | – |
+| 2.0 | 0.40 | – | – | 71.2 | **71.2** | 70.0 | – |
+| 4.0 | 0.10 | 0.2 | 0.8 | 5.4 | 42.3 | 53.7 | 53.6 |
+| 4.0 | 0.20 | 0.2 | 1.2 | 9.0 | 45.2 | 56.0 | 57.2 |
+| 4.0 | 0.30 | – | – | – | – | **57.3** | 57.0 |
+| 4.0 | 0.40 | – | – | – | – | 56.2 | 57.0 |
 
-Checks off this grid: σ = 0: √e = 0.02 / 0.04 m → 85.6 / 85.4; σ = 0.5: √e = 0.04 → 82.6; \
-σ = 1: √e = 0.08 → 78.8; σ = 2: √e = 0.24 m (the reference's plotted value) → 68.7, d = 0.30 m \
-(beyond the reference grid's 0.20 m) → 70.4, planes ≥ 5 rays → 69.7; σ = 4: √e = 0.50 / 0.60 → \
-55.3 / 54.5, d = 0.30 → 57.2. The post-processing (`refine_rounds`, not in the thesis) on the \
-σ = 2 cm training split at √e = d = 0.20 m: none 64.0 %, boundary refinement and adjacent \
-merges 66.0 %, plus merging the pieces of a face split by an occluder 69.7 % (n_o 2.7 → 0.7, \
-n_s 30.3 → 20.9). The PEAC-style preset comes from its own grid at σ = 2 cm (see \
-`PeacParams::synpeb`); MSAC is not grid-searched.
+Checks off this grid at √e = 0.20 m: σ = 2: d = 0.60 m → 68.9, d = ∞ → 69.1; σ = 4 \
+(√e = 0.40): d = 0.60 → 56.0. The post-processing (`refine_rounds`, not in the thesis) on \
+the σ = 2 cm training split at √e = d = 0.20 m: none 64.0 %, boundary refinement and \
+adjacent merges 66.0 %, plus merging the pieces of a face split by an occluder 69.7 % \
+(n_o 2.7 → 0.7, n_s 30.3 → 20.9). The PEAC-style preset comes from its own grid at \
+σ = 2 cm (see `PeacParams::synpeb`); MSAC is not grid-searched.
 ";
 
 /// How the thesis' RMSE is defined and why ours differs.
