@@ -1,0 +1,72 @@
+//! Real data: raw and corrected Intel scans pair one to one, and Hector with the odometry
+//! guess beats the odometry on the relative-motion error.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // test code: a panic is the failure report
+
+use std::path::PathBuf;
+
+use raypath_geometry::Pose2;
+use raypath_reflectivity::MatcherConfig;
+use raypath_reflectivity::PointFilter;
+use raypath_reflectivity::benchmark::{
+    consecutive_relations, pair_by_ranges, read_laser_log, relative_errors, run_matcher,
+};
+
+fn data(relative: &str) -> PathBuf {
+    let root = std::env::var("RAYPATH_DATA").unwrap_or_else(|_| "datasets".into());
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(root)
+        .join(relative)
+}
+
+#[test]
+fn intel_pairs_and_scan_matching_beats_odometry() {
+    let (raw, corrected) = (
+        data("carmen/raw/intel.clf.bz2"),
+        data("carmen/corrected/intel-corrected.log.gz"),
+    );
+    if !raw.exists() || !corrected.exists() {
+        eprintln!(
+            "skipping: {} or {} not found",
+            raw.display(),
+            corrected.display()
+        );
+        return;
+    }
+    let raw = read_laser_log(&raw).unwrap();
+    let reference = read_laser_log(&corrected).unwrap();
+    assert_eq!((raw.len(), reference.len()), (13631, 910));
+    let pairs = pair_by_ranges(&raw, &reference);
+    assert_eq!(pairs.len(), 910);
+    // The corrected log's first scan is the raw scan with logger time 32.906827 s.
+    let (i0, _) = pairs[0];
+    assert!((raw[i0].logger_timestamp_secs - 32.906827).abs() < 1e-6);
+    // The first 2000 raw scans with the odometry as the initial guess.
+    let raw = &raw[..2000];
+    let (_, results) = run_matcher(
+        raw,
+        MatcherConfig::default(),
+        &PointFilter::default(),
+        None,
+        true,
+    )
+    .unwrap();
+    let used: Vec<(usize, usize)> = pairs.iter().copied().filter(|&(i, _)| i < 2000).collect();
+    let truth: Vec<Pose2> = used
+        .iter()
+        .map(|&(_, j)| reference[j].world_from_laser)
+        .collect();
+    let est: Vec<Pose2> = used
+        .iter()
+        .map(|&(i, _)| results[i].world_from_sensor)
+        .collect();
+    let odo: Vec<Pose2> = used.iter().map(|&(i, _)| raw[i].world_from_laser).collect();
+    let rel = consecutive_relations(truth.len());
+    let matched = relative_errors(&truth, &est, &rel);
+    let odometry = relative_errors(&truth, &odo, &rel);
+    assert!(
+        matched.rotation_rad.mean < 0.5 * odometry.rotation_rad.mean,
+        "{matched:?} vs {odometry:?}"
+    );
+    assert!(matched.translation_m.mean < 0.05, "{matched:?}");
+}
