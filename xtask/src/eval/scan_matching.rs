@@ -208,6 +208,14 @@ fn run_real(ctx: &EvalContext, md: &mut String) -> Result<Value> {
         );
     }
     let _ = writeln!(md, "{}", table.to_markdown());
+    let _ = writeln!(
+        md,
+        "Without odometry, the first bad relations on Intel fall on in-place turns of about \
+         0.5 rad within 6–9 raw scans (≈ 0.08 rad per scan at Intel's ≈ 5 Hz): points 5 m away \
+         move by ≈ 0.4 m between scans, beyond the basin of the coarsest (20 cm) level, and the \
+         match slips by 0.2–0.7 m. Hector assumes scans at the laser's 40 Hz; with odometry as \
+         the initial guess the same matcher stays within a few centimetres.\n"
+    );
     Ok(Value::Array(out))
 }
 
