@@ -65,7 +65,8 @@ fn main() {
     let scans: Vec<(Pose3, &PointCloud)> = clouds.iter().map(|(p, c)| (*p, c)).collect();
     for _ in 0..3 {
         let (poles, stats) =
-            extract_poles(&scans, &Point3::new(0.0, 0.0, 1.73), &PoleParams::kitti()).expect("extract");
+            extract_poles(&scans, &Point3::new(0.0, 0.0, 1.73), &PoleParams::kitti())
+                .expect("extract");
         println!("{} poles, {:?}", poles.len(), stats);
     }
 }
