@@ -26,40 +26,52 @@ pub struct Segment {
     pub length_m: f64,
 }
 
-/// Per-axis tables of one segment for the moment kernel.
+/// Per-axis tables of one segment for the moment kernel (structure of arrays, so the inner
+/// loop vectorizes): `cos`/`sin` of `k c̃` at the midpoint and of `k ũ` (half-length phase),
+/// and `k ũ` itself, for `k < n`.
+#[derive(Default)]
 struct AxisTables {
-    /// `cos(k c̃), sin(k c̃)` at the midpoint, `k < n`.
-    mid: Vec<(f64, f64)>,
-    /// `cos(k ũ), sin(k ũ)` with `ũ` the half-length phase.
-    half: Vec<(f64, f64)>,
-    /// `k ũ`.
+    mid_cos: Vec<f64>,
+    mid_sin: Vec<f64>,
+    half_cos: Vec<f64>,
+    half_sin: Vec<f64>,
     u: Vec<f64>,
 }
 
-fn axis_tables(n: usize, mid_phase: f64, half_phase: f64) -> AxisTables {
-    let mut t = AxisTables {
-        mid: Vec::with_capacity(n),
-        half: Vec::with_capacity(n),
-        u: Vec::with_capacity(n),
-    };
-    for k in 0..n {
-        let kf = k as f64;
-        let (s, c) = (kf * mid_phase).sin_cos();
-        t.mid.push((c, s));
-        let (s, c) = (kf * half_phase).sin_cos();
-        t.half.push((c, s));
-        t.u.push(kf * half_phase);
+impl AxisTables {
+    fn fill(&mut self, n: usize, mid_phase: f64, half_phase: f64) {
+        for v in [
+            &mut self.mid_cos,
+            &mut self.mid_sin,
+            &mut self.half_cos,
+            &mut self.half_sin,
+            &mut self.u,
+        ] {
+            v.clear();
+        }
+        for k in 0..n {
+            let kf = k as f64;
+            let (s, c) = (kf * mid_phase).sin_cos();
+            self.mid_cos.push(c);
+            self.mid_sin.push(s);
+            let (s, c) = (kf * half_phase).sin_cos();
+            self.half_cos.push(c);
+            self.half_sin.push(s);
+            self.u.push(kf * half_phase);
+        }
     }
-    t
 }
 
+/// `sin(u) / u`, with the series `1 − u²/6` where `|u| ≤ 1e-4` (branch-free select).
 #[inline(always)]
 fn sinc_over(sin_u: f64, u: f64) -> f64 {
-    if u.abs() > 1e-4 {
-        sin_u / u
-    } else {
-        1.0 - u * u / 6.0
-    }
+    let small = u.abs() <= 1e-4;
+    let ratio = sin_u / if small { 1.0 } else { u };
+    if small { 1.0 - u * u / 6.0 } else { ratio }
+}
+
+thread_local! {
+    static TABLES: std::cell::RefCell<(AxisTables, AxisTables)> = Default::default();
 }
 
 /// Adds `weight · T_pq(segment)` for `p < P`, `q < Q` of `shape` to `out` (length `P · Q`,
@@ -76,28 +88,35 @@ pub fn add_moments(shape: Shape, extent_m: [f64; 2], seg: &Segment, weight: f64,
     let mid_y = (seg.origin[1] + seg.direction[1] * r * 0.5) * sy;
     let half_x = seg.direction[0] * r * 0.5 * sx;
     let half_y = seg.direction[1] * r * 0.5 * sy;
-    let tx = axis_tables(pn, mid_x, half_x);
-    let ty = axis_tables(qn, mid_y, half_y);
     let scale = 0.5 * r * weight;
-    for p in 0..pn {
-        let (mxr, mxi) = tx.mid[p];
-        let (hxr, hxi) = tx.half[p];
-        let ux = tx.u[p];
-        let row = &mut out[p * qn..(p + 1) * qn];
-        for (q, o) in row.iter_mut().enumerate() {
-            let (myr, myi) = ty.mid[q];
-            let (hyr, hyi) = ty.half[q];
-            let uy = ty.u[q];
-            // cos(p x̃ ± q ỹ) at the midpoint, sin(p ũx ± q ũy) of the half length.
-            let (rr, ii) = (mxr * myr, mxi * myi);
-            let (cos_p, cos_m) = (rr - ii, rr + ii);
-            let (a, b) = (hxr * hyi, hxi * hyr);
-            let (sin_p, sin_m) = (b + a, b - a);
-            let (u_p, u_m) = (ux + uy, ux - uy);
-            // Eq. (9.10), sinc form: r cos(φ + ω r/2) sinc(ω r/2).
-            *o += scale * (cos_p * sinc_over(sin_p, u_p) + cos_m * sinc_over(sin_m, u_m));
+    TABLES.with(|cell| {
+        let (tx, ty) = &mut *cell.borrow_mut();
+        tx.fill(pn, mid_x, half_x);
+        ty.fill(qn, mid_y, half_y);
+        for p in 0..pn {
+            let (mxr, mxi) = (tx.mid_cos[p], tx.mid_sin[p]);
+            let (hxr, hxi) = (tx.half_cos[p], tx.half_sin[p]);
+            let ux = tx.u[p];
+            let row = &mut out[p * qn..(p + 1) * qn];
+            let it = row
+                .iter_mut()
+                .zip(&ty.mid_cos)
+                .zip(&ty.mid_sin)
+                .zip(&ty.half_cos)
+                .zip(&ty.half_sin)
+                .zip(&ty.u);
+            for (((((o, &myr), &myi), &hyr), &hyi), &uy) in it {
+                // cos(p x̃ ± q ỹ) at the midpoint, sin(p ũx ± q ũy) of the half length.
+                let (rr, ii) = (mxr * myr, mxi * myi);
+                let (cos_p, cos_m) = (rr - ii, rr + ii);
+                let (a, b) = (hxr * hyi, hxi * hyr);
+                let (sin_p, sin_m) = (b + a, b - a);
+                // Eq. (9.10), sinc form: r cos(φ + ω r/2) sinc(ω r/2).
+                *o +=
+                    scale * (cos_p * sinc_over(sin_p, ux + uy) + cos_m * sinc_over(sin_m, ux - uy));
+            }
         }
-    }
+    });
 }
 
 /// `T_pq` of one segment (a fresh vector of length `P · Q`).

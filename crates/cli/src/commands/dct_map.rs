@@ -109,6 +109,18 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     if args.rays == 0 {
         return Err(Failure::input("--rays must be positive", json));
     }
+    if let Some(out) = &args.out {
+        let ext = out
+            .extension()
+            .map(|e| e.to_string_lossy().to_lowercase())
+            .unwrap_or_default();
+        if ext != "png" && ext != "json" {
+            return Err(Failure::input(
+                format!("--out {}: use a .json or .png file name", out.display()),
+                json,
+            ));
+        }
+    }
     let rays = read_rays(args)?;
     let patch = if args.patch == "auto" {
         auto_patch(&rays, 10.0).ok_or_else(|| {
