@@ -2,9 +2,9 @@
 //! semi-synthetic KITTI drive (Schaefer 2020, §12.5, Table 12.2).
 //!
 //! * Data: `datasets/generated/semi-kitti` — simulated HDL-64E scans along the **real**
-//!   trajectory of KITTI odometry sequence 07 among its **real** poles (`raypath-sim`). The
-//!   other `kitti-poles` sequences (00–06) are not simulated: one full semi-synthetic
-//!   sequence is 2.6 GB of scans and ≈ 7 min of extraction here.
+//!   trajectory of KITTI odometry sequence 07 among its **real** poles (`raypath-sim`), and in
+//!   the full run also `urban-kitti` (a procedural street world). The other `kitti-poles`
+//!   sequences (00–06) are not simulated: one semi-synthetic sequence is 2.6 GB of scans.
 //! * Protocol (as the thesis, `kittipoles.py`): local maps every 3 m over 5 m of trajectory
 //!   with the ground-truth poses, merged into the reference map; localization on the same
 //!   drive with 2000 particles, 3 m / ±5° initial spread, increments corrupted by
@@ -172,8 +172,8 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     )?;
     writeln!(
         md,
-        "## Detection quality\n\nMap poles against the simulated poles within 12 m of the \
-         driven scans; a match is the closest unused pair within 1 m.\n\n{}",
+        "## Detection quality\n\nMap poles within 12 m of the driven scans against the \
+         simulated poles there; a match is the closest unused pair within 1 m.\n\n{}",
         detection.to_markdown()
     )?;
     writeln!(
