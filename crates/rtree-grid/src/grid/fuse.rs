@@ -111,8 +111,9 @@ impl RtreeGrid {
                 _ => false,
             };
         }
-        // Fail fast on the slab's corner cubes when they are unfused cells of the wrong
-        // state (one hash probe each, before any tree walk).
+        // Necessary conditions on the slab's 8 corner cubes, checked with point look-ups
+        // (hash probe, or a point query near fused cells) before the slab query: each must
+        // lie in a known cell that is clamped with the right polarity and inside the slab.
         for corner in 0..8u8 {
             let key = [0, 1, 2].map(|a| {
                 if corner & (1 << a) != 0 {
@@ -121,12 +122,16 @@ impl RtreeGrid {
                     slab.lo[a]
                 }
             });
-            if let Some(id) = self.index.get(key, Self::key_of_cell(&self.tree)) {
-                if self.is_clamped(self.log_odds[id as usize]) != Some(occupied) {
-                    return false;
-                }
-            } else if !self.coverage.may_contain(key) {
+            let Some(id) = self.cell_id_of_key(key) else {
                 return false; // unknown space
+            };
+            if self.is_clamped(self.log_odds[id as usize]) != Some(occupied)
+                || !self
+                    .tree
+                    .item_box(id)
+                    .is_some_and(|b| slab.contains_box(&b))
+            {
+                return false;
             }
         }
         let ok = self.tree.for_each_intersecting_while(slab, &mut |id, bx| {

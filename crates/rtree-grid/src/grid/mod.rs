@@ -83,6 +83,7 @@ pub struct RtreeGrid {
     index: LatticeIndex,
     fused_cells: usize,
     coverage: FusedCoverage,
+    last_fused: Option<(u32, KeyBox)>,
     l_hit: f32,
     l_miss: f32,
     l_min: f32,
@@ -141,6 +142,7 @@ impl RtreeGrid {
             index: LatticeIndex::default(),
             fused_cells: 0,
             coverage: FusedCoverage::default(),
+            last_fused: None,
             l_hit: logit(config.prob_hit) as f32,
             l_miss: logit(config.prob_miss) as f32,
             l_min: logit(config.clamp_min) as f32,
@@ -331,7 +333,11 @@ impl RtreeGrid {
             return Some(id);
         }
         if self.coverage.may_contain(key) {
-            if let Some((id, bx)) = self.tree.find_containing(key) {
+            // Sorted keys run along x: the previous fused cell often holds the next key too.
+            let cached = self.last_fused.filter(|&(_, bx)| bx.contains_key(key));
+            let found = cached.or_else(|| self.tree.find_containing(key));
+            if let Some((id, bx)) = found {
+                self.last_fused = Some((id, bx));
                 let l = self.log_odds[id as usize];
                 let leaves_clamp = self.is_clamped(l).is_some()
                     && self.is_clamped(self.updated(l, hit)) != self.is_clamped(l);
@@ -399,6 +405,7 @@ impl RtreeGrid {
     }
 
     fn delete_cell(&mut self, id: u32) -> Cell {
+        self.last_fused = None;
         let cell = self.cell(id);
         if cell.bx.volume() == 1 {
             self.index.remove(cell.bx.lo, Self::key_of_cell(&self.tree));
@@ -458,6 +465,7 @@ impl RtreeGrid {
     /// Renumbers the cells and rebuilds the arenas without the holes left by fusion
     /// (`O(n)`; runs automatically after a scan once half the cell ids are dead).
     pub fn compact(&mut self) {
+        self.last_fused = None;
         let map = self.tree.compact();
         let mut log_odds = vec![0.0f32; self.tree.len()];
         for (old, &new) in map.iter().enumerate() {

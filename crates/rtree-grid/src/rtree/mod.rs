@@ -220,6 +220,20 @@ impl RTree {
         }
     }
 
+    /// The child ids of `node`.
+    #[inline]
+    fn child_ids(&self, node: u32) -> &[u32] {
+        let start = node as usize * self.cap;
+        &self.ids[start..start + self.len_of(node)]
+    }
+
+    /// The entry boxes of an inner node.
+    #[inline]
+    fn inner_entry_boxes(&self, node: u32) -> &[KeyBox] {
+        let start = self.box_block[node as usize] as usize * self.cap;
+        &self.inner_boxes[start..start + self.len_of(node)]
+    }
+
     /// Sets the box of entry `i` of an inner node.
     #[inline]
     fn set_entry_box(&mut self, node: u32, i: usize, bx: KeyBox) {
@@ -469,15 +483,17 @@ impl RTree {
     }
 
     fn find_containing_in(&self, node: u32, key: Key) -> Option<(u32, KeyBox)> {
-        let leaf = self.level[node as usize] == 0;
-        for i in 0..self.len_of(node) {
-            let b = self.entry_box(node, i);
+        let ids = self.child_ids(node);
+        if self.level[node as usize] == 0 {
+            return ids.iter().find_map(|&id| {
+                let b = self.item_boxes[id as usize];
+                b.contains_key(key).then_some((id, b))
+            });
+        }
+        let boxes = self.inner_entry_boxes(node);
+        for (b, &child) in boxes.iter().zip(ids) {
             if b.contains_key(key) {
-                let id = self.id_at(node, i);
-                if leaf {
-                    return Some((id, b));
-                }
-                if let Some(found) = self.find_containing_in(id, key) {
+                if let Some(found) = self.find_containing_in(child, key) {
                     return Some(found);
                 }
             }
@@ -509,18 +525,20 @@ impl RTree {
         query: &KeyBox,
         visit: &mut impl FnMut(u32, &KeyBox) -> bool,
     ) -> bool {
-        let leaf = self.level[node as usize] == 0;
-        for i in 0..self.len_of(node) {
-            let b = self.entry_box(node, i);
-            if b.intersects(query) {
-                let go_on = if leaf {
-                    visit(self.id_at(node, i), &b)
-                } else {
-                    self.intersecting_in(self.id_at(node, i), query, visit)
-                };
-                if !go_on {
+        let ids = self.child_ids(node);
+        if self.level[node as usize] == 0 {
+            for &id in ids {
+                let b = &self.item_boxes[id as usize];
+                if b.intersects(query) && !visit(id, b) {
                     return false;
                 }
+            }
+            return true;
+        }
+        let boxes = self.inner_entry_boxes(node);
+        for (b, &child) in boxes.iter().zip(ids) {
+            if b.intersects(query) && !self.intersecting_in(child, query, visit) {
+                return false;
             }
         }
         true
