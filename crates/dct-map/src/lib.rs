@@ -27,7 +27,7 @@
 //! * `λ = g²` is itself a cosine series with `(2L − 1)(2M − 1)` terms whose coefficients are
 //!   the **self-convolution** `b_pq` of `a` ([`self_convolution`]), so a ray integral is
 //!   `Σ_pq b_pq T_pq` with closed-form moments `T_pq` ([`moments`]): about `4 I` terms per
-//!   ray instead of the `8 I²` of Eq. (9.10) (kept in [`reference`] for the tests).
+//!   ray instead of the `8 I²` of Eq. (9.10) (kept in [`reference`](mod@reference) for the tests).
 //! * In a fit every hit and `super` ray enters the likelihood through `−𝒮` with weight one,
 //!   so the integral part of the whole data set is `−aᵀ K a` with one Gram matrix `K` of the
 //!   summed moments, built once; the hit Hessians `−2 φφᵀ/g²` sum to the same kind of matrix
@@ -86,7 +86,7 @@
 //!   such as `(cos π/2, −1) = (6e-17, −1)` gives `ω ≈ 1e-17 ≠ 0`, and
 //!   `(sin(φ + ωr) − sin φ)/ω` divides rounding noise by it. The `sinc` form
 //!   `r cos(φ + ωr/2) sinc(ωr/2)` (spec §5.4) is used everywhere; the literal form is kept in
-//!   [`reference`] and the test shows the difference.
+//!   [`reference`](mod@reference) and the test shows the difference.
 //! * **Ridge.** The thesis maximizes the bare likelihood. With fewer rays than coefficients
 //!   (its own 500-ray timing sets at 40 × 40) the Gram matrix has near-null directions, and
 //!   along them the rounding error of `aᵀ K a` let Newton's method "increase" the likelihood

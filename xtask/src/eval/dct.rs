@@ -77,6 +77,8 @@ struct Cell {
     lbfgs_ll: f64,
     newton_fit_s: f64,
     newton_train_ll: f64,
+    worst_ray_ll: f64,
+    grid_worst_ray_ll: f64,
 }
 
 fn log_rays(path: &Path) -> Result<Vec<Ray2>> {
@@ -197,6 +199,9 @@ fn run_log(
                 (400 / nx.max(1)) as u32,
             )?;
         }
+        let worst = |f: &dyn Fn(&MapRay) -> f64| held.iter().map(f).fold(f64::INFINITY, f64::min);
+        let worst_ray_ll = worst(&|r| map.ray_log_likelihood(r));
+        let grid_worst_ray_ll = worst(&|r| grid.ray_log_likelihood(r));
         cells.push(Cell {
             log: name.clone(),
             size: n,
@@ -213,6 +218,8 @@ fn run_log(
             lbfgs_ll,
             newton_fit_s,
             newton_train_ll: newton_ll,
+            worst_ray_ll,
+            grid_worst_ray_ll,
         });
     }
     if let Some(dir) = &fig_dir {
@@ -274,6 +281,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             json: json!({ "status": "skipped: no data" }),
         });
     }
+    let load_before = load_average();
     let bar = ctx.progress(logs.len() as u64, NAME);
     let mut cells = Vec::new();
     let mut infos = Vec::new();
@@ -285,6 +293,13 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         bar.inc(1);
     }
     bar.finish_and_clear();
+    let _ = writeln!(
+        md,
+        "Load average (1 min) of the machine: {load_before} at the start, {} at the end — other \
+         evaluations ran at the same time, so absolute times are inflated; ratios within one row \
+         were measured side by side.\n",
+        load_average()
+    );
     md.push_str(&report_markdown(ctx, &cells, &infos, sizes));
     let json_cells: Vec<_> = cells
         .iter()
@@ -296,6 +311,8 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
                 "grid_time_500_s": c.grid_time500_s, "lbfgs_fit_s": c.lbfgs_time_s,
                 "lbfgs_train_log_likelihood": c.lbfgs_ll, "newton_fit_s": c.newton_fit_s,
                 "newton_train_log_likelihood": c.newton_train_ll,
+                "worst_held_back_ray_log_likelihood": c.worst_ray_ll,
+                "grid_worst_held_back_ray_log_likelihood": c.grid_worst_ray_ll,
             })
         })
         .collect();
@@ -305,6 +322,13 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         markdown: md,
         json: json!({ "logs": infos, "results": json_cells, "quick": ctx.quick, "threads": rayon::current_num_threads() }),
     })
+}
+
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|s| s.split_whitespace().next().map(str::to_owned))
+        .unwrap_or_else(|| "n/a".into())
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -430,7 +454,14 @@ fn report_markdown(
          maps from the {MAPPING_RAYS} mapping rays; mean and σ over logs of DCT − GM; p: one-sided \
          paired t-test (H1: DCT higher). Thesis (DCT − GM) in brackets.\n"
     );
-    let mut t = Table::new(["params", "DCT − GM μ", "DCT − GM σ", "p [%]", "DCT higher"]);
+    let mut t = Table::new([
+        "params",
+        "DCT − GM μ",
+        "DCT − GM σ",
+        "DCT − GM median",
+        "p [%]",
+        "DCT higher",
+    ]);
     for &n in sizes {
         let d: Vec<f64> = cells
             .iter()
@@ -453,6 +484,7 @@ fn report_markdown(
                 fmt_num(s, 1),
                 th.map(|t| fmt_num(t.8, 1)).unwrap_or_default()
             ),
+            fmt_num(median(d.clone()), 1),
             fmt_num(paired_less(&neg, &zeros) * 100.0, 2),
             format!("{}/{}", d.iter().filter(|v| **v > 0.0).count(), d.len()),
         ]);
@@ -523,6 +555,8 @@ fn report_markdown(
             fmt_num(c.grid_rmse, 4),
             fmt_num(c.ll, 1),
             fmt_num(c.grid_ll, 1),
+            fmt_num(c.worst_ray_ll, 1),
+            fmt_num(c.grid_worst_ray_ll, 1),
             fmt_num(c.time_s, 3),
             c.iterations.to_string(),
         ]);
