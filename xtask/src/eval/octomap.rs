@@ -380,8 +380,10 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
            OctoMap (28.51 % fewer at 0.2 m, beam-based), M does not change the leaves, Rtree \
            insertion is slower and access to occupied cells faster. The thesis used the 81-scan \
            Freiburg campus graph, which is not available here.\n\
-         - Fusion selection is the thesis' (end-point cells plus cells sampled along each \
-           beam, one per 10 base cubes); fused cells are updated as a whole (no splitting).\n\
+         - Fusion selection is the thesis' (end-point cells plus cells drawn at random along \
+           the beams: each traversed cell with probability 1/10, the spec's one sample per 10 \
+           base cubes); fused cells are updated as a whole (no splitting).\n\
+         - Scans simulated inside `geb079.bt` are not part of this evaluation yet.\n\
          - OctoMap's leaf counts are after `prune()`; OctoMap prunes during updates as well.\n"
     )?;
     let json = json!({
