@@ -120,7 +120,7 @@ pub use mapping::{Segment, SlidingWindowFilter, merge_poles, overlap_clusters, s
 pub use params::PoleParams;
 pub use pipeline::{
     DetectionQuality, ExtractionTotals, LocalMap, OdometryNoise, Preset, RunResult, SegmentParams,
-    detection_quality, local_maps, localize_run, online_poles, reference_map,
+    detection_quality, filter_run, local_maps, localize_run, online_poles, reference_map,
 };
 pub use pole::Pole;
 pub use pole_map::{

@@ -245,9 +245,9 @@ pub fn online_poles(local_maps: &[LocalMap], preset: &Preset) -> Vec<(usize, Vec
 
 /// One particle-filter run over the scans `range` of `drive`: motion updates at every scan
 /// from the odometry (with `noise`), measurement updates with `online` poles (in the frame
-/// of `registration`, e.g. the odometry) when their local map completes. Evaluated against
-/// the ground truth every 1 m.
-#[allow(clippy::too_many_arguments, clippy::needless_range_loop)]
+/// of `registration`, e.g. the odometry) when their local map completes. Starts at the
+/// ground truth of the first scan and is evaluated against the ground truth every 1 m.
+#[allow(clippy::too_many_arguments)]
 pub fn localize_run(
     drive: &Drive,
     range: std::ops::Range<usize>,
@@ -259,13 +259,57 @@ pub fn localize_run(
     seed: u64,
 ) -> Result<RunResult> {
     let gt = drive.require_ground_truth()?;
+    let end = range.end.min(drive.len()).min(gt.len());
+    let first = range.start.min(end);
+    let start = gt.get(first).map(Pose3::to_planar).unwrap_or_default();
+    let (estimate, updates, update_secs) = filter_run(
+        drive,
+        first..end,
+        map,
+        online,
+        registration,
+        filter_params,
+        noise,
+        start,
+        seed,
+    )?;
+    let gt_track = PoseTrack::from_parts(
+        drive.stamps_secs[first..end].to_vec(),
+        gt[first..end].iter().map(Pose3::to_planar).collect(),
+    )?;
+    let evaluation = evaluate_trajectory(&gt_track, &estimate, &EvaluationConfig::default())?;
+    Ok(RunResult {
+        evaluation,
+        updates,
+        update_secs,
+    })
+}
+
+/// The filter alone (no ground truth needed): particles drawn around `start` (the world
+/// pose at the first scan of `range`). Returns the estimated track (one pose per scan), the
+/// number of measurement updates and the seconds they took.
+#[allow(
+    clippy::too_many_arguments,
+    clippy::needless_range_loop,
+    clippy::type_complexity
+)]
+pub fn filter_run(
+    drive: &Drive,
+    range: std::ops::Range<usize>,
+    map: &[Pole],
+    online: &[(usize, Vec<Pole>)],
+    registration: &[Pose3],
+    filter_params: &FilterParams,
+    noise: OdometryNoise,
+    start: Pose2,
+    seed: u64,
+) -> Result<(PoseTrack<Pose2>, usize, f64)> {
     let end = range.end.min(drive.len());
     let first = range.start.min(end);
-    if registration.len() < end || gt.len() < end || drive.odometry.len() < end {
+    if registration.len() < end || drive.odometry.len() < end {
         return Err(PoleError::Sequence {
             path: drive.dir.clone(),
-            reason: "the registration, ground-truth or odometry track is shorter than the drive"
-                .into(),
+            reason: "the registration or odometry track is shorter than the drive".into(),
         });
     }
     if end - first < 2 {
@@ -275,7 +319,6 @@ pub fn localize_run(
         });
     }
     let planar = |p: &Pose3| p.to_planar();
-    let start = planar(&gt[first]);
     let mut filter = PoleFilter::new(map, filter_params.clone(), start, seed)?;
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x6f64_6f6d);
     let unit = Normal::new(0.0, 1.0).map_err(|e| PoleError::InvalidParameter {
@@ -334,17 +377,8 @@ pub fn localize_run(
         stamps.push(drive.stamps_secs[k]);
         estimates.push(filter.estimate());
     }
-    let gt_track = PoseTrack::from_parts(
-        drive.stamps_secs[first..end].to_vec(),
-        gt[first..end].iter().map(planar).collect(),
-    )?;
     let estimate = PoseTrack::from_parts(stamps, estimates)?;
-    let evaluation = evaluate_trajectory(&gt_track, &estimate, &EvaluationConfig::default())?;
-    Ok(RunResult {
-        evaluation,
-        updates,
-        update_secs,
-    })
+    Ok((estimate, updates, update_secs))
 }
 
 /// Detection quality of extracted poles against ground-truth positions.

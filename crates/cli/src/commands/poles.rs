@@ -8,7 +8,9 @@
 //!   merged into a reference map (`x,y,width,height,score`).
 //! * `localize --map map.csv <sequence>`: particle-filter runs with online poles from local
 //!   maps along the odometry (KITTI: ground-truth increments corrupted by 2 % noise); the
-//!   error summary every 1 m against the ground truth.
+//!   error summary every 1 m against the ground truth. Particles start around the ground truth
+//!   of the first scan or around `--start x,y,theta`; without ground truth only the final
+//!   estimates are printed (`"summary": null`).
 //!
 //! `--json` prints one document: `extract`/`map` → `{"sequence", "preset", "scans",
 //! "local_maps", "poles": [{x, y, width, height, score}], "points_per_sec"}`; `localize` →
@@ -17,8 +19,11 @@
 
 use std::path::PathBuf;
 
+use raypath_geometry::{Pose2, Pose3};
+use raypath_localizer::PoseTrack;
+use raypath_localizer::eval::{EvaluationConfig, evaluate_trajectory};
 use raypath_poles::{
-    Drive, DriveFormat, OdometryNoise, Pole, Preset, RunResult, local_maps, localize_run,
+    Drive, DriveFormat, OdometryNoise, Pole, Preset, RunResult, filter_run, local_maps,
     online_poles, read_pole_csv, reference_map, write_pole_csv,
 };
 use serde_json::json;
@@ -103,6 +108,16 @@ pub struct LocalizeArgs {
     /// Seed of the first run.
     #[arg(long, default_value_t = 1, value_name = "S")]
     pub seed: u64,
+    /// Initial pose `x,y,theta` (metres, radians, world frame) around which the particles are
+    /// drawn; default: the ground truth at the first scan.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        num_args = 3,
+        value_name = "X,Y,THETA",
+        allow_hyphen_values = true
+    )]
+    pub start: Option<Vec<f64>>,
 }
 
 /// Runs the subcommand.
@@ -181,7 +196,7 @@ fn print_poles(poles: &[Pole]) {
     }
 }
 
-fn mapping_track(drive: &Drive) -> Vec<raypath_geometry::Pose3> {
+fn mapping_track(drive: &Drive) -> Vec<Pose3> {
     drive
         .ground_truth
         .clone()
@@ -279,9 +294,32 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
             json,
         ));
     }
-    drive
-        .require_ground_truth()
-        .map_err(|e| Failure::input(e, json))?;
+    let start = match (&args.start, &drive.ground_truth) {
+        (Some(v), _) => match v.as_slice() {
+            [x, y, theta] if x.is_finite() && y.is_finite() && theta.is_finite() => {
+                Pose2::new(*x, *y, *theta)
+            }
+            _ => {
+                return Err(Failure::input(
+                    "--start needs three finite numbers x,y,theta",
+                    json,
+                ));
+            }
+        },
+        (None, Some(gt)) => gt
+            .get(range.start)
+            .map(Pose3::to_planar)
+            .unwrap_or_default(),
+        (None, None) => {
+            return Err(Failure::input(
+                format!(
+                    "{}: no ground-truth poses; give the initial pose with --start x,y,theta",
+                    c.sequence.display()
+                ),
+                json,
+            ));
+        }
+    };
     // Online poles: local maps along the odometry (KITTI: the poses, see the module docs).
     let registration = drive.odometry.clone();
     let (maps, _) = local_maps(&drive, &registration, range.clone(), &preset, |_, _| {})
@@ -295,20 +333,62 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
         },
     };
     let mut runs: Vec<RunResult> = Vec::with_capacity(args.runs);
+    let mut finals = Vec::with_capacity(args.runs);
     for r in 0..args.runs {
-        runs.push(
-            localize_run(
-                &drive,
-                range.clone(),
-                &map,
-                &online,
-                &registration,
-                &preset.filter,
-                noise,
-                args.seed + r as u64,
+        let (track, updates, update_secs) = filter_run(
+            &drive,
+            range.clone(),
+            &map,
+            &online,
+            &registration,
+            &preset.filter,
+            noise,
+            start,
+            args.seed + r as u64,
+        )
+        .map_err(|e| Failure::input(e, json))?;
+        if let Some(last) = track.poses().last() {
+            finals.push(json!({"x": last.x(), "y": last.y(), "theta": last.theta()}));
+        }
+        if let Some(gt) = &drive.ground_truth {
+            let end = range.end.min(gt.len());
+            let gt_track = PoseTrack::from_parts(
+                drive.stamps_secs[range.start..end].to_vec(),
+                gt[range.start..end].iter().map(Pose3::to_planar).collect(),
             )
-            .map_err(|e| Failure::input(e, json))?,
-        );
+            .map_err(|e| Failure::input(e, json))?;
+            let evaluation = evaluate_trajectory(&gt_track, &track, &EvaluationConfig::default())
+                .map_err(|e| Failure::input(e, json))?;
+            runs.push(RunResult {
+                evaluation,
+                updates,
+                update_secs,
+            });
+        }
+    }
+    if runs.is_empty() {
+        // No ground truth: report the final estimates only.
+        if json {
+            println!(
+                "{}",
+                json!({
+                    "sequence": c.sequence.display().to_string(),
+                    "map": args.map.display().to_string(),
+                    "preset": preset_name(c, &drive),
+                    "runs": args.runs,
+                    "summary": null,
+                    "final_poses": finals,
+                })
+            );
+        } else {
+            println!(
+                "{}: {} run(s), no ground truth; final poses: {}",
+                c.sequence.display(),
+                args.runs,
+                serde_json::Value::from(finals)
+            );
+        }
+        return Ok(());
     }
     let summary = summary(&runs);
     if json {
