@@ -24,7 +24,7 @@ pub struct PoleParams {
     /// errata 13 — the default follows the thesis).
     pub occupancy_threshold: f64,
     /// Minimum pole score `q_min` on the `[0, 1]`-remapped score `q' = q/2 + 1/2` (0.6;
-    /// errata 12).
+    /// errata 12); must exceed 1/2 (raw score 0).
     pub min_score: f64,
     /// Minimum pole height `h_min`, metres (1.0).
     pub min_height_m: f64,

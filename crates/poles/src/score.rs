@@ -13,9 +13,13 @@ pub struct ScoreVolume {
     pub dims: [usize; 3],
     /// Number of widths scored (`a = 1..=widths`).
     pub widths: usize,
-    /// `Q = max_a q'_a` per voxel (linear index, x fastest), in `[0, 1]`.
+    /// `Q = max_a q'_a` per voxel (linear index, x fastest), in `[0, 1]`. Scores at or below
+    /// 1/2 (raw score ≤ 0: no evidence for a pole) are stored as 0, so slices and widths
+    /// without any positive raw score skip the last filter pass; this is exact for every
+    /// `q_min > 1/2` ([`PoleParams::min_score`](crate::PoleParams::min_score)).
     pub best: Vec<f32>,
-    /// `q'_a` per width and voxel, quantized to `u8` (`q' ≈ v / 255`), width-major:
+    /// `q'_a` per width and voxel (0 at or below 1/2), quantized to `u8` (`q' ≈ v / 255`),
+    /// width-major:
     /// `per_width[(a − 1) · n + j]`.
     pub per_width: Vec<u8>,
 }
@@ -142,6 +146,7 @@ impl SliceWork {
             grow(&mut self.strip_h, &self.rows_f, span - 1);
             grow(&mut self.strip_v, &self.cols_f, (span - 1) * nx);
             self.raw.fill(-1.0);
+            let mut any_positive = false;
             let inv_area = 1.0 / (a * a) as f64;
             for ky in f..=(ny - a - f) {
                 for kx in f..=(nx - a - f) {
@@ -151,8 +156,14 @@ impl SliceWork {
                     let left = self.strip_v[(ky - f) * nx + kx - f];
                     let right = self.strip_v[(ky - f) * nx + kx + a];
                     let hull = below.max(above).max(left).max(right);
-                    self.raw[ky * nx + kx] = inside as f32 - hull;
+                    let raw = inside as f32 - hull;
+                    any_positive |= raw > 0.0;
+                    self.raw[ky * nx + kx] = raw;
                 }
+            }
+            if !any_positive {
+                // No placement with evidence for a pole: every q'_a ≤ 1/2 is stored as 0.
+                continue;
             }
             // q_a(j): best placement whose a × a footprint contains j (anchors j−a+1 ..= j).
             let lo = -(a as isize - 1);
@@ -169,10 +180,12 @@ impl SliceWork {
             let Some(bytes) = per_a.get_mut(a - 1) else {
                 continue;
             };
-            for ((b, q), out) in best.iter_mut().zip(&self.q).zip(bytes.iter_mut()) {
-                let remapped = 0.5 * q + 0.5; // errata 12: q' = q/2 + 1/2
-                *b = b.max(remapped);
-                *out = (remapped.clamp(0.0, 1.0) * 255.0).round() as u8;
+            for ((b, &q), out) in best.iter_mut().zip(&self.q).zip(bytes.iter_mut()) {
+                if q > 0.0 {
+                    let remapped = 0.5 * q + 0.5; // errata 12: q' = q/2 + 1/2
+                    *b = b.max(remapped);
+                    *out = (remapped.min(1.0) * 255.0).round() as u8;
+                }
             }
         }
     }
