@@ -2,7 +2,7 @@
 #![allow(missing_docs, clippy::expect_used)]
 use nalgebra::{Point3, Vector3};
 use raypath_geometry::{PointCloud, Pose3};
-use raypath_poles::{PoleParams, extract_poles};
+use raypath_poles::{HitMissGrid, PoleParams, extract_poles, local_grid, occupancy, pole_scores};
 const CYLINDERS: [(f64, f64, f64); 6] = [
     (5.0, 6.0, 0.1),
     (12.0, 6.0, 0.15),
@@ -68,5 +68,26 @@ fn main() {
             extract_poles(&scans, &Point3::new(0.0, 0.0, 1.73), &PoleParams::kitti())
                 .expect("extract");
         println!("{} poles, {:?}", poles.len(), stats);
+    }
+    let params = PoleParams::kitti();
+    let mut counts =
+        HitMissGrid::new(local_grid(&Point3::new(0.0, 0.0, 1.73), &params).expect("grid"));
+    counts.insert_scans_par(&scans, 120.0);
+    for _ in 0..3 {
+        let t = std::time::Instant::now();
+        let (occ, _) = occupancy(&counts, params.occupancy_threshold);
+        let t_occ = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
+        let s = pole_scores(
+            &occ,
+            params.dims(),
+            params.max_width_cells,
+            params.hull_cells(),
+        );
+        let t_score = t.elapsed().as_secs_f64();
+        println!(
+            "occupancy {t_occ:.3} s, scores {t_score:.3} s ({} voxels)",
+            s.best.len()
+        );
     }
 }

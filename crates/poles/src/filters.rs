@@ -161,6 +161,7 @@ pub(crate) fn summed_area(input: &[f32], nx: usize, ny: usize, table: &mut Vec<f
 
 /// The sum over `[x, x + w) × [y, y + h)` from a summed-area table (the box must lie inside).
 #[inline]
+#[cfg(test)]
 pub(crate) fn box_sum(table: &[f64], nx: usize, x: usize, y: usize, w: usize, h: usize) -> f64 {
     let s = nx + 1;
     table[(y + h) * s + x + w] - table[y * s + x + w] - table[(y + h) * s + x] + table[y * s + x]
