@@ -6,7 +6,17 @@ use raypath_rtree_grid::{GridConfig, RtreeGrid, SensorModel};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let graph = raypath_io::octomap::read_graph(std::path::Path::new(&args[1])).unwrap();
+    let Some(path) = args.get(1) else {
+        eprintln!("usage: profile <scans.graph> [resolution_m]");
+        std::process::exit(2);
+    };
+    let graph = match raypath_io::octomap::read_graph(std::path::Path::new(path)) {
+        Ok(graph) => graph,
+        Err(error) => {
+            eprintln!("error: {error}");
+            std::process::exit(2);
+        }
+    };
     let r: f64 = args.get(2).map_or(0.2, |s| s.parse().unwrap());
     for (label, fusion, model) in [
         ("beam, fusion", true, SensorModel::BeamBased),
