@@ -28,7 +28,7 @@ fn bench(c: &mut Criterion) {
     let scan = room_scan(20_000);
     for model in [SensorModel::BeamBased, SensorModel::BeamEndPoint] {
         c.bench_function(
-            &format!("insert 20k-beam scan ({model:?}, r = 0.2, M = 8)"),
+            &format!("insert 3 × 20k-beam scans ({model:?}, r = 0.2, M = 8)"),
             |b| {
                 b.iter(|| {
                     let mut grid = RtreeGrid::new(GridConfig::with(0.2, 8, model)).unwrap();
