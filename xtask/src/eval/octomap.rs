@@ -1,9 +1,10 @@
 //! `cargo xtask eval octomap`: the Rtree variable-resolution grid (Khan 2017, ch. 2) beside
 //! OctoMap, measured in the same run on the same scans.
 //!
-//! * Data: the real `octomap/scan.dat.bz2` (sensor at the origin) and a simulated urban
-//!   drive (raypath-sim `urban-kitti`, HDL-64E). Every data set is written as an OctoMap
-//!   `.graph` (raypath-io) and read by both sides.
+//! * Data: the real `octomap/scan.dat.bz2` (sensor at the origin), a simulated urban
+//!   drive (raypath-sim `urban-kitti`, HDL-64E) and scans simulated inside the real building
+//!   map `octomap/geb079.bt`. Every data set is written as an OctoMap `.graph` (raypath-io)
+//!   and read by both sides.
 //! * OctoMap 1.9 (the installed liboctomap) through `xtask/octomap/driver.cpp`, built with
 //!   `g++ -O2` into `target/octomap-driver`: `insertPointCloud` (beam-based) or the
 //!   de-duplicated end points (beam-end-point), then `prune()`, `memoryUsage()`, the leaf
@@ -15,7 +16,9 @@
 //!   the other, on a machine shared with other jobs: compare ratios, not absolute times.
 
 mod data;
+mod geb079;
 mod peer;
+mod plot;
 
 use std::fmt::Write;
 use std::time::Instant;
@@ -105,6 +108,74 @@ fn model_name(model: SensorModel) -> &'static str {
     }
 }
 
+/// One plotted configuration (M = 8).
+struct PlotRow {
+    data: String,
+    resolution_m: f64,
+    endpoint: bool,
+    /// Leaves: ours, OctoMap's pruned (NaN without OctoMap).
+    leaves: [f64; 2],
+    /// Insertion µs per point: ours, OctoMap's.
+    insert_us: [f64; 2],
+}
+
+/// Draws the plots into `docs/results/octomap/`; returns file names and captions.
+fn write_figures(
+    ctx: &EvalContext,
+    sets: &[Dataset],
+    rows: &[PlotRow],
+) -> Result<Vec<(String, String)>> {
+    if rows.is_empty() {
+        return Ok(Vec::new());
+    }
+    let dir = ctx.figure_dir(NAME)?;
+    let mut resolutions: Vec<f64> = rows.iter().map(|r| r.resolution_m).collect();
+    resolutions.sort_by(f64::total_cmp);
+    resolutions.dedup();
+    let panels = |value: &dyn Fn(&PlotRow) -> [f64; 2]| -> Vec<plot::Panel> {
+        sets.iter()
+            .map(|set| plot::Panel {
+                groups: resolutions
+                    .iter()
+                    .map(|&r| {
+                        let mut bars = [None; 4];
+                        for row in rows.iter().filter(|row| {
+                            row.data == set.name && (row.resolution_m - r).abs() < 1e-9
+                        }) {
+                            let v = value(row);
+                            let at = if row.endpoint { 2 } else { 0 };
+                            bars[at] = Some(v[0]);
+                            bars[at + 1] = Some(v[1]);
+                        }
+                        (format!("{r}"), bars)
+                    })
+                    .collect(),
+            })
+            .collect()
+    };
+    let names: Vec<&str> = sets.iter().map(|s| s.name.as_str()).collect();
+    let legend = format!(
+        "panels left to right: {}; groups: resolution r in m; bars: ours beam-based (dark blue), \
+         OctoMap beam-based (dark orange), ours end-point (light blue), OctoMap end-point (light \
+         orange); M = 8; log scale, labels are powers of ten",
+        names.join(", ")
+    );
+    let mut out = Vec::new();
+    let file = "leaves.png";
+    plot::bar_chart(&dir.join(file), &panels(&|r| r.leaves))?;
+    out.push((
+        file.to_owned(),
+        format!("Leaves, ours vs pruned OctoMap ({legend})."),
+    ));
+    let file = "insert_us_per_point.png";
+    plot::bar_chart(&dir.join(file), &panels(&|r| r.insert_us))?;
+    out.push((
+        file.to_owned(),
+        format!("Insertion time per point in µs, fusion included ({legend})."),
+    ));
+    Ok(out)
+}
+
 /// Runs the evaluation.
 pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     let (resolutions, orders): (&[f64], &[usize]) = if ctx.quick {
@@ -123,6 +194,13 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         data::urban(ctx, 30, 1, 4)?
     };
     sets.extend(urban);
+    // Scans simulated inside the real building map (360 × 32 beams each).
+    sets.extend(geb079::geb079(
+        ctx,
+        if ctx.quick { 2 } else { 10 },
+        360,
+        32,
+    )?);
     let driver = peer::build(&ctx.workspace_root);
     if let Err(why) = &driver {
         eprintln!("octomap: OctoMap unavailable: {why}; reporting our side only");
@@ -158,6 +236,10 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     let (mut ours_insert_02, mut peer_insert_02) = (0.0, 0.0);
     let (mut ours_bytes_02, mut peer_bytes_02) = (0usize, 0usize);
     let mut reduction_02: Option<(String, f64)> = None;
+    // geb079 at r = 0.2 m, M = 8, beam-based (reported beside the summary, not in it).
+    let mut geb079_02: Option<(f64, f64, f64)> = None;
+    // Per data set, model and resolution at M = 8: leaves and µs/point, ours and OctoMap's.
+    let mut plot_rows: Vec<PlotRow> = Vec::new();
     let mut variants = Table::new([
         "data",
         "variant",
@@ -251,7 +333,28 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
                         .as_ref()
                         .map(|p| ours.bytes as f64 / p.memory_bytes as f64);
                     let agree = peer.as_ref().map(|p| agreement(&ours.classes, &p.classes));
-                    if (r - 0.2).abs() < 1e-9 && m == 8 && !endpoint {
+                    if m == 8 {
+                        plot_rows.push(PlotRow {
+                            data: set.name.clone(),
+                            resolution_m: r,
+                            endpoint,
+                            leaves: [
+                                ours.leaves as f64,
+                                peer.as_ref().map_or(f64::NAN, |p| p.leaves as f64),
+                            ],
+                            insert_us: [
+                                ours.insert_secs / points * 1e6,
+                                peer.as_ref()
+                                    .map_or(f64::NAN, |p| p.insert_secs / points * 1e6),
+                            ],
+                        });
+                    }
+                    let at_02 = (r - 0.2).abs() < 1e-9 && m == 8 && !endpoint;
+                    if at_02 && set.name == "geb079" {
+                        if let (Some(red), Some(ins), Some(b)) = (reduction, ratio, bytes_ratio) {
+                            geb079_02 = Some((red, ins, b));
+                        }
+                    } else if at_02 {
                         if let Some(p) = &peer {
                             ours_insert_02 += ours.insert_secs;
                             peer_insert_02 += p.insert_secs;
@@ -344,16 +447,42 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         "28.51 % fewer leaves at 0.2 m (Freiburg campus, Fig. 2.9b); aim ≥ 28.5 %".into(),
     ]);
     summary.row([
-        "insertion time ours / OctoMap (all data sets)".to_owned(),
+        "insertion time ours / OctoMap (scan.dat, scan.dat-x5, urban)".to_owned(),
         insertion_ratio.map_or("—".into(), |v| fmt_num(v, 2)),
         "thesis: Rtree slower (> 1, Fig. 2.9c); aim ≤ 1".into(),
     ]);
     summary.row([
-        "bytes ours / OctoMap memoryUsage() (all data sets)".to_owned(),
+        "bytes ours / OctoMap memoryUsage() (scan.dat, scan.dat-x5, urban)".to_owned(),
         bytes_ratio.map_or("—".into(), |v| fmt_num(v, 2)),
         "thesis: not reported; aim < 1".into(),
     ]);
+    if let Some((red, ins, b)) = geb079_02 {
+        summary.row([
+            "geb079 (not in the rows above): leaf reduction / insertion ratio / bytes ratio"
+                .to_owned(),
+            format!(
+                "{:.2} % / {} / {}",
+                100.0 * red,
+                fmt_num(ins, 2),
+                fmt_num(b, 2)
+            ),
+            "thesis: 28.51 % / > 1 / —; aim ≥ 28.5 % / ≤ 1 / < 1".into(),
+        ]);
+    }
     md.push_str(&summary.to_markdown());
+    writeln!(
+        md,
+        "\nThe summary keys of `target/eval/octomap.json` keep their meaning: the leaf \
+         reduction on the urban drive, the insertion-time and bytes ratios summed over \
+         scan.dat, scan.dat-x5 and urban. The geb079 figures are under `summary.geb079`.\n"
+    )?;
+    let figures = write_figures(ctx, &sets, &plot_rows)?;
+    if !figures.is_empty() {
+        writeln!(md, "\n## Plots\n")?;
+        for (file, caption) in &figures {
+            writeln!(md, "![{caption}](octomap/{file})\n\n*{caption}*\n")?;
+        }
+    }
     writeln!(md, "\n## All runs\n")?;
     writeln!(
         md,
@@ -383,7 +512,9 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          - Fusion selection is the thesis' (end-point cells plus cells drawn at random along \
            the beams: each traversed cell with probability 1/10, the spec's one sample per 10 \
            base cubes); fused cells are updated as a whole (no splitting).\n\
-         - Scans simulated inside `geb079.bt` are not part of this evaluation yet.\n\
+         - geb079: scans simulated in the real 0.08 m building map (see Data); a static \
+           indoor scene seen from a few positions, so cells near the sensors are observed \
+           several times.\n\
          - OctoMap's leaf counts are after `prune()`; OctoMap prunes during updates as well.\n"
     )?;
     let json = json!({
@@ -393,6 +524,11 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             "insertion_time_ratio_vs_octomap": insertion_ratio,
             "bytes_ratio_vs_octomap": bytes_ratio,
             "octomap_available": driver.is_ok(),
+            "geb079": geb079_02.map(|(red, ins, b)| json!({
+                "leaf_reduction_vs_pruned_octomap_0_2m": red,
+                "insertion_time_ratio_vs_octomap": ins,
+                "bytes_ratio_vs_octomap": b,
+            })),
         },
         "runs": rows,
     });

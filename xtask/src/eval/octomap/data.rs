@@ -26,7 +26,7 @@ pub struct Dataset {
     pub queries_path: PathBuf,
 }
 
-fn node(id: u32, world_from_sensor: Pose3, points: Vec<Point3<f32>>) -> ScanNode {
+pub(super) fn node(id: u32, world_from_sensor: Pose3, points: Vec<Point3<f32>>) -> ScanNode {
     ScanNode {
         id,
         world_from_sensor,
@@ -143,7 +143,12 @@ pub fn urban(
 
 /// Writes the graph and draws query points: per scan, points at random fractions
 /// `t ∈ [0, 1.05]` of random beams (free space, the surfaces and just behind them).
-fn finish(ctx: &EvalContext, name: &str, about: String, graph: ScanGraph) -> Result<Dataset> {
+pub(super) fn finish(
+    ctx: &EvalContext,
+    name: &str,
+    about: String,
+    graph: ScanGraph,
+) -> Result<Dataset> {
     let dir = ctx.workspace_root.join("target/eval/octomap");
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let path = dir.join(format!("{name}.graph"));
