@@ -12,6 +12,7 @@ mod datasets;
 mod eval;
 mod generate;
 mod render;
+mod stats;
 mod table;
 
 use anyhow::Result;

@@ -107,7 +107,7 @@ mod pole;
 mod pole_map;
 mod score;
 
-pub use beta::{ReflectionPrior, ln_gamma, regularized_incomplete_beta};
+pub use beta::ReflectionPrior;
 pub use drive::{Drive, DriveFormat};
 pub use error::{PoleError, Result};
 pub use extract::{

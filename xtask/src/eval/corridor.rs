@@ -287,97 +287,13 @@ fn run_one(model: CorridorModel, n_visits: u32, run: usize, belief: &mut Vec<f64
     }
 }
 
-/// Mean and paired one-tailed t-test of `a − b > 0`.
+/// Share of pairs with `a > b` and the p-value of the paired one-tailed t-test of `a − b > 0`.
 fn paired_test(a: &[f64], b: &[f64]) -> (f64, f64) {
-    let d: Vec<f64> = a.iter().zip(b).map(|(x, y)| x - y).collect();
-    let k = d.len() as f64;
-    if d.len() < 2 {
+    if a.len() < 2 {
         return (f64::NAN, f64::NAN);
     }
-    let mean = d.iter().sum::<f64>() / k;
-    let var = d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (k - 1.0);
-    let wins = d.iter().filter(|&&x| x > 0.0).count() as f64 / k;
-    if var <= 0.0 {
-        return (wins, if mean > 0.0 { 0.0 } else { 1.0 });
-    }
-    let t = mean / (var / k).sqrt();
-    (wins, student_t_upper(t, k - 1.0))
-}
-
-/// `P(T > t)` for Student's t with `df` degrees of freedom.
-fn student_t_upper(t: f64, df: f64) -> f64 {
-    let x = df / (df + t * t);
-    let tail = 0.5 * incomplete_beta(0.5 * df, 0.5, x);
-    if t > 0.0 { tail } else { 1.0 - tail }
-}
-
-/// `ln Γ(x)` for `x > 0` (Lanczos, g = 7, 9 terms; relative error ~1e-15).
-fn ln_gamma(x: f64) -> f64 {
-    const G: [f64; 9] = [
-        0.999_999_999_999_809_9,
-        676.520_368_121_885_1,
-        -1_259.139_216_722_402_8,
-        771.323_428_777_653_1,
-        -176.615_029_162_140_6,
-        12.507_343_278_686_905,
-        -0.138_571_095_265_720_12,
-        9.984_369_578_019_572e-6,
-        1.505_632_735_149_311_6e-7,
-    ];
-    if x < 0.5 {
-        let pi = std::f64::consts::PI;
-        return (pi / (pi * x).sin()).ln() - ln_gamma(1.0 - x);
-    }
-    let x = x - 1.0;
-    let mut sum = G[0];
-    for (i, g) in G.iter().enumerate().skip(1) {
-        sum += g / (x + i as f64);
-    }
-    let t = x + 7.5;
-    0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + sum.ln()
-}
-
-/// The regularized incomplete beta function `I_x(a, b)` (continued fraction, Lentz).
-fn incomplete_beta(a: f64, b: f64, x: f64) -> f64 {
-    if x <= 0.0 {
-        return 0.0;
-    }
-    if x >= 1.0 {
-        return 1.0;
-    }
-    let front =
-        (ln_gamma(a + b) - ln_gamma(a) - ln_gamma(b) + a * x.ln() + b * (1.0 - x).ln()).exp();
-    if x < (a + 1.0) / (a + b + 2.0) {
-        front * beta_fraction(a, b, x) / a
-    } else {
-        1.0 - front * beta_fraction(b, a, 1.0 - x) / b
-    }
-}
-
-fn beta_fraction(a: f64, b: f64, x: f64) -> f64 {
-    const TINY: f64 = 1e-300;
-    let guard = |v: f64| if v.abs() < TINY { TINY } else { v };
-    let (qab, qap, qam) = (a + b, a + 1.0, a - 1.0);
-    let mut c = 1.0;
-    let mut d = 1.0 / guard(1.0 - qab * x / qap);
-    let mut h = d;
-    for m in 1..100_000 {
-        let m = f64::from(m);
-        let m2 = 2.0 * m;
-        let aa = m * (b - m) * x / ((qam + m2) * (a + m2));
-        d = 1.0 / guard(1.0 + aa * d);
-        c = guard(1.0 + aa / c);
-        h *= d * c;
-        let aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2));
-        d = 1.0 / guard(1.0 + aa * d);
-        c = guard(1.0 + aa / c);
-        let delta = d * c;
-        h *= delta;
-        if (delta - 1.0).abs() < 1e-15 {
-            break;
-        }
-    }
-    h
+    let wins = a.iter().zip(b).filter(|(x, y)| x > y).count() as f64 / a.len() as f64;
+    (wins, crate::stats::paired_greater(a, b))
 }
 
 /// Results for one model and `n`.
@@ -565,17 +481,6 @@ pub fn section(ctx: &EvalContext) -> Result<(String, serde_json::Value)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn student_t_tail_known_values() {
-        // Tables: t = 2.228, df = 10 → 0.025; t = 1.96, large df → 0.025; t = 0 → 0.5.
-        assert!((student_t_upper(2.228_138_85, 10.0) - 0.025).abs() < 1e-6);
-        assert!((student_t_upper(1.959_964, 1e7) - 0.025).abs() < 1e-5);
-        assert!((student_t_upper(0.0, 5.0) - 0.5).abs() < 1e-12);
-        assert!((student_t_upper(-2.228_138_85, 10.0) - 0.975).abs() < 1e-6);
-        // Normal tail at 3.719: 1.0e-4.
-        assert!((student_t_upper(3.719_016, 1e6) / 1e-4 - 1.0).abs() < 1e-3);
-    }
 
     #[test]
     fn perfect_information_tracks_the_true_voxel() {

@@ -7,8 +7,6 @@
 //! parameters a DCT map and a grid map. Table 9.4 times the fit from 500 rays (the thesis'
 //! timing set) and from 10⁴ rays; both solvers are timed side by side.
 
-mod stats;
-
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
@@ -24,8 +22,8 @@ use raypath_io::carmen::{CarmenReader, Record};
 use serde_json::json;
 
 use super::{EvalContext, EvalReport};
+use crate::stats::{mean_std, paired_less};
 use crate::table::{Table, fmt_num};
-use stats::{mean_std, paired_less};
 
 const NAME: &str = "dct";
 const PATCH_M: f64 = 10.0;
