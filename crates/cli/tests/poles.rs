@@ -176,6 +176,36 @@ fn extract_map_and_localize() {
 }
 
 #[test]
+fn a_kitti_root_with_one_sequence_is_that_sequence() {
+    let tmp = tempfile::tempdir().unwrap();
+    let seq = write_drive(&tmp.path().join("sequences"), 12);
+    let by_root = json_of(&raypath(&[
+        "poles",
+        "extract",
+        tmp.path().to_str().unwrap(),
+        "--json",
+    ]));
+    let by_seq = json_of(&raypath(&[
+        "poles",
+        "extract",
+        seq.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(by_root["poles"], by_seq["poles"]);
+    assert!(!by_root["poles"].as_array().unwrap().is_empty());
+    // Two sequences: the user must name one.
+    write_drive(&tmp.path().join("sequences/01"), 2);
+    std::fs::rename(
+        tmp.path().join("sequences/01/00"),
+        tmp.path().join("sequences/02"),
+    )
+    .unwrap();
+    let out = raypath(&["poles", "extract", tmp.path().to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("name one"));
+}
+
+#[test]
 fn bad_input_exits_2_with_file_and_place() {
     let tmp = tempfile::tempdir().unwrap();
     let out = raypath(&[

@@ -54,8 +54,28 @@ pub struct Drive {
 
 impl Drive {
     /// Opens a KITTI sequence or an NCLT session (detected from the directory contents).
+    /// A KITTI dataset root (`sequences/NN/`, `poses/NN.txt`) holding exactly one sequence
+    /// opens that sequence.
     pub fn open(dir: &Path) -> Result<Self> {
         let has = |p: &str| dir.join(p).exists();
+        if has("sequences") && !has("velodyne") {
+            let mut sequences: Vec<PathBuf> = std::fs::read_dir(dir.join("sequences"))
+                .map(|it| it.filter_map(|e| e.ok().map(|e| e.path())).collect())
+                .unwrap_or_default();
+            sequences.retain(|p| p.is_dir());
+            sequences.sort();
+            return match sequences.as_slice() {
+                [one] => Self::open(one),
+                _ => Err(PoleError::Sequence {
+                    path: dir.to_path_buf(),
+                    reason: format!(
+                        "a KITTI root with {} sequences under sequences/: name one (e.g. {})",
+                        sequences.len(),
+                        dir.join("sequences/00").display()
+                    ),
+                }),
+            };
+        }
         if has("velodyne") || has("poses.txt") || has("calib.txt") || has("times.txt") {
             return Self::open_kitti(dir);
         }
