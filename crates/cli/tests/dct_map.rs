@@ -6,16 +6,11 @@
 use std::f64::consts::PI;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use raypath_io::data::require;
 
-fn raypath(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypath"))
-        .args(args)
-        .output()
-        .expect("the raypath binary runs")
-}
+mod common;
+use common::{json_of, raypath};
 
 /// A CARMEN log of `scans` FLASER scans (180 beams over 180°) in the room [−3, 4] × [−2, 2.5] m
 /// from poses on a small circle, turning by 0.4 rad per scan.
@@ -57,15 +52,6 @@ fn room_log(dir: &Path, scans: usize) -> PathBuf {
         .unwrap();
     }
     path
-}
-
-fn json_of(out: &Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("valid JSON")
 }
 
 const CONTRACT: [&str; 7] = [

@@ -1,14 +1,9 @@
 //! `raypath info` end to end: the binary on real data, on broken files and on bad arguments.
 
 use raypath_io::data::require;
-use std::process::{Command, Output};
 
-fn raypath(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypath"))
-        .args(args)
-        .output()
-        .expect("the raypath binary runs")
-}
+mod common;
+use common::raypath;
 
 fn info_json(path: &std::path::Path) -> serde_json::Value {
     let out = raypath(&["info", path.to_str().expect("UTF-8 path"), "--json"]);

@@ -3,7 +3,6 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // test code: a panic is the failure report
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use nalgebra::Point2;
 use raypath_geometry::{Aabb2, Grid2, Pose2, Scan2};
@@ -12,12 +11,8 @@ use raypath_sensor_models::export::{MapFile, MapKind, StoredStats};
 use raypath_sensor_models::{DenseStats2, DenseStats3, MappingConfig};
 use raypath_sim::indoor::{FloorPlanConfig, IndoorConfig, Laser2Config, WorldConfig, generate};
 
-fn raypath(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypath"))
-        .args(args)
-        .output()
-        .expect("the raypath binary runs")
-}
+mod common;
+use common::raypath;
 
 fn s(path: &Path) -> &str {
     path.to_str().expect("UTF-8 path")

@@ -3,17 +3,12 @@
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use raypath_io::data::require;
 use raypath_sensor_models::export::{MapFile, MapKind, StoredStats};
 
-fn raypath(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypath"))
-        .args(args)
-        .output()
-        .expect("the raypath binary runs")
-}
+mod common;
+use common::raypath;
 
 fn s(path: &Path) -> &str {
     path.to_str().expect("UTF-8 path")

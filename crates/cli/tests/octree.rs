@@ -4,28 +4,14 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // test code: a panic is the failure report
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use nalgebra::Point3;
 use raypath_geometry::{PointCloud, Pose3};
 use raypath_io::data::require;
 use raypath_io::octomap::{ScanGraph, ScanNode, read_bt, write_graph_file};
 
-fn raypath(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypath"))
-        .args(args)
-        .output()
-        .expect("the raypath binary runs")
-}
-
-fn json_of(out: &Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("valid JSON")
-}
+mod common;
+use common::{json_of, raypath};
 
 /// A box room [−3, 3] × [−2, 2] × [−1, 2] m scanned `scans` times from near the origin.
 fn room_graph(dir: &Path, scans: usize) -> PathBuf {

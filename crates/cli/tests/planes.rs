@@ -4,19 +4,14 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // test code: a panic is the failure report
 
 use std::path::Path;
-use std::process::{Command, Output};
 
 use nalgebra::Point3;
 use raypath_geometry::PointCloud;
 use raypath_io::data::require;
 use raypath_io::pcd::{DataEncoding, write_pcd};
 
-fn raypath(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypath"))
-        .args(args)
-        .output()
-        .expect("the raypath binary runs")
-}
+mod common;
+use common::raypath;
 
 /// A 40 × 30 organized scan of the wall x = 3 m (label 10) and the floor z = −1 m
 /// (label 11), labels in `intensity`.

@@ -4,11 +4,13 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // test code: a panic is the failure report
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use nalgebra::{Matrix3x4, Point3, Vector3};
 use raypath_geometry::{PointCloud, Pose3};
 use raypath_io::kitti;
+
+mod common;
+use common::{json_of, raypath};
 
 /// Poles (x, y, radius) beside a straight street along x.
 const POLES: [(f64, f64, f64); 6] = [
@@ -20,13 +22,6 @@ const POLES: [(f64, f64, f64); 6] = [
     (24.0, -5.5, 0.12),
 ];
 const HEIGHT: f64 = 1.73;
-
-fn raypath(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypath"))
-        .args(args)
-        .output()
-        .expect("the raypath binary runs")
-}
 
 /// Points of a scan from `sensor` (world frame) in the sensor frame (identity rotation).
 fn scan(sensor: &Point3<f64>) -> PointCloud {
@@ -91,15 +86,6 @@ fn write_drive(dir: &Path, scans: usize) -> PathBuf {
     )
     .unwrap();
     seq
-}
-
-fn json_of(out: &Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "raypath failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("one JSON document")
 }
 
 fn nearest(poles: &[serde_json::Value], x: f64, y: f64) -> f64 {

@@ -5,16 +5,11 @@
 use std::f64::consts::PI;
 use std::io::Write;
 use std::path::Path;
-use std::process::{Command, Output};
 
 use raypath_io::data::require;
 
-fn raypath(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypath"))
-        .args(args)
-        .output()
-        .expect("the raypath binary runs")
-}
+mod common;
+use common::{json_of, raypath};
 
 /// A CARMEN log of `scans` FLASER scans (180 beams over 180°) of the room
 /// [−3, 4] × [−2, 2.5] m seen from the origin, turning by 0.3 rad per scan.
@@ -55,15 +50,6 @@ fn room_log(dir: &Path, scans: usize) -> std::path::PathBuf {
         .unwrap();
     }
     path
-}
-
-fn json_of(out: &Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("valid JSON")
 }
 
 #[test]

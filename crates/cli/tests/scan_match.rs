@@ -6,23 +6,9 @@
 use std::f64::consts::PI;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn raypath(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypath"))
-        .args(args)
-        .output()
-        .expect("the raypath binary runs")
-}
-
-fn json_of(out: &Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "stderr: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("one JSON document")
-}
+mod common;
+use common::{json_of, raypath};
 
 /// Range from `(x, y)` along `a` to the walls of [−3, 4] × [−2, 2.5] m or the pillar
 /// [1, 1.5] × [0.8, 1.2] m.

@@ -3,16 +3,11 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // test code: a panic is the failure report
 
 use std::io::Write;
-use std::process::{Command, Output};
 
 use raypath_io::data::require;
 
-fn raypath(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_raypath"))
-        .args(args)
-        .output()
-        .expect("the raypath binary runs")
-}
+mod common;
+use common::raypath;
 
 const FAST: [&str; 4] = ["--max-test-scans", "12", "--beam-step", "4"];
 
