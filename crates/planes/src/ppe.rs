@@ -762,43 +762,11 @@ impl<'a> State<'a> {
         }
         pairs.sort_unstable();
         pairs.dedup();
-        let e_max = self.params.max_increment_m2;
-        let mut heap: BinaryHeap<Entry> = pairs
-            .into_iter()
-            .filter(|&(a, b)| {
-                self.clusters[a as usize].members.len() >= 4
-                    && self.clusters[b as usize].members.len() >= 4
-            })
-            .map(|(a, b)| Entry {
-                key: self.mrg_increment(a, b),
-                action: Action::Merge { a, b },
-            })
-            .filter(|e| e.key <= e_max)
-            .collect();
-        let mut merged = 0;
-        while let Some(entry) = heap.pop() {
-            let Action::Merge { a, b } = entry.action else {
-                continue;
-            };
-            let (ra, rb) = (self.root(a), self.root(b));
-            if ra == rb {
-                continue;
-            }
-            let key = self.mrg_increment(ra, rb);
-            if key > e_max {
-                continue;
-            }
-            if key > entry.key && heap.peek().is_some_and(|n| key > n.key) {
-                heap.push(Entry {
-                    key,
-                    action: Action::Merge { a: ra, b: rb },
-                });
-                continue;
-            }
-            self.merge(ra, rb);
-            merged += 1;
-        }
-        merged
+        pairs.retain(|&(a, b)| {
+            self.clusters[a as usize].members.len() >= 4
+                && self.clusters[b as usize].members.len() >= 4
+        });
+        self.merge_pairs(pairs)
     }
 
     /// Merges planes that are pieces of one surface seen on both sides of an occluder:
@@ -808,7 +776,6 @@ impl<'a> State<'a> {
     /// of merges.
     fn merge_occluded(&mut self) -> usize {
         let min_points = self.params.min_points.max(4);
-        let e_max = self.params.max_increment_m2;
         let is_big = |s: &Self, l: u32| {
             l != NONE
                 && s.clusters
@@ -873,6 +840,14 @@ impl<'a> State<'a> {
         }
         pairs.sort_unstable();
         pairs.dedup();
+        self.merge_pairs(pairs)
+    }
+
+    /// Merges the given plane pairs (and what they become), least increment first, while the
+    /// increment stays at most `e`; a pair whose increment grew since it was queued goes back
+    /// into the queue. Returns the number of merges.
+    fn merge_pairs(&mut self, pairs: Vec<(u32, u32)>) -> usize {
+        let e_max = self.params.max_increment_m2;
         let mut heap: BinaryHeap<Entry> = pairs
             .into_iter()
             .map(|(a, b)| Entry {
