@@ -197,8 +197,30 @@ impl Pose3 {
 
     /// The pose from a row-major 3×4 matrix `[R | t]` (the KITTI pose layout). The rotation
     /// block is re-orthonormalized, so rounding in text files does not leak into the quaternion.
+    ///
+    /// The block must be a rotation up to rounding; for matrices read from files use
+    /// [`Pose3::try_from_matrix3x4`]. A block far from a rotation (`|RᵀR − I| > 0.5`
+    /// entrywise, `det R ≤ 0`, non-finite entries) gives a pose with NaN rotation components
+    /// (never a hang in the orthonormalization).
     pub fn from_matrix3x4(matrix: &Matrix3x4<f64>) -> Self {
         let rotation_block: Matrix3<f64> = matrix.fixed_view::<3, 3>(0, 0).into_owned();
+        // nalgebra's iteration loops forever when the norms it compares are inf or NaN, or
+        // when all rotations are equally far (a zero block): only near-rotations go in.
+        let near_rotation = rotation_block
+            .iter()
+            .all(|v| v.is_finite() && v.abs() < 1e6)
+            && (rotation_block.transpose() * rotation_block - Matrix3::identity())
+                .abs()
+                .max()
+                <= 0.5
+            && rotation_block.determinant() > 0.0;
+        if !near_rotation {
+            let nan = nalgebra::Quaternion::new(f64::NAN, f64::NAN, f64::NAN, f64::NAN);
+            return Self::from_parts(
+                matrix.column(3).into_owned(),
+                UnitQuaternion::new_unchecked(nan),
+            );
+        }
         let rotation = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_eps(
             &rotation_block,
             1e-12,
@@ -206,6 +228,20 @@ impl Pose3 {
             Rotation3::identity(),
         ));
         Self::from_parts(matrix.column(3).into_owned(), rotation)
+    }
+
+    /// Like [`Pose3::from_matrix3x4`], for untrusted input: `None` unless all twelve entries
+    /// are finite and the 3×3 block is a proper rotation up to `1e-2` (`|RᵀR − I| ≤ 1e-2`
+    /// entrywise, `det R > 0`).
+    pub fn try_from_matrix3x4(matrix: &Matrix3x4<f64>) -> Option<Self> {
+        if !matrix.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        let block: Matrix3<f64> = matrix.fixed_view::<3, 3>(0, 0).into_owned();
+        let error = (block.transpose() * block - Matrix3::identity())
+            .abs()
+            .max();
+        (error <= 1e-2 && block.determinant() > 0.0).then(|| Self::from_matrix3x4(matrix))
     }
 
     /// The row-major 3×4 matrix `[R | t]`.

@@ -94,6 +94,28 @@ proptest! {
     }
 
     #[test]
+    fn pose3_from_any_matrix_terminates(
+        entries in prop::collection::vec(
+            prop_oneof![
+                -2.0..2.0f64,
+                Just(0.0),
+                Just(f64::INFINITY),
+                Just(f64::NAN),
+                Just(1e300),
+                Just(-1e300),
+            ],
+            12,
+        ),
+    ) {
+        let m = nalgebra::Matrix3x4::from_row_slice(&entries);
+        let pose = Pose3::from_matrix3x4(&m);
+        if let Some(checked) = Pose3::try_from_matrix3x4(&m) {
+            prop_assert!(checked.rotation().coords.iter().all(|v| v.is_finite()));
+            prop_assert!(pose.rotation().coords.iter().all(|v| v.is_finite()));
+        }
+    }
+
+    #[test]
     fn pose3_conversions_round_trip(a in pose3()) {
         prop_assert!(distance3(&Pose3::from_matrix3x4(&a.to_matrix3x4()), &a) < 1e-9);
         let (roll, pitch, yaw) = a.rpy();
@@ -109,4 +131,21 @@ proptest! {
         let turns = (angle - w) / (2.0 * PI);
         prop_assert!((turns - turns.round()).abs() < 1e-9);
     }
+}
+
+/// Blocks on which nalgebra's orthonormalization never ends (a zero block: every rotation is
+/// equally far; infinite entries) give NaN rotations instead of hanging, and are refused by
+/// the checked constructor.
+#[test]
+fn pose3_from_degenerate_blocks_terminates() {
+    for fill in [0.0, f64::INFINITY, f64::NAN, 1e300] {
+        let m = nalgebra::Matrix3x4::from_element(fill);
+        assert!(Pose3::try_from_matrix3x4(&m).is_none());
+        let pose = Pose3::from_matrix3x4(&m);
+        assert!(pose.rotation().coords.iter().any(|v| v.is_nan()));
+    }
+    let identity =
+        nalgebra::Matrix3x4::new(1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 2.0, 0.0, 0.0, 1.0, 3.0);
+    let pose = Pose3::try_from_matrix3x4(&identity).expect("a rigid transform");
+    assert!((pose.translation() - nalgebra::Vector3::new(1.0, 2.0, 3.0)).norm() < 1e-12);
 }

@@ -51,10 +51,11 @@ impl KittiCalib {
     }
 
     /// The velodyne → cam0 transform (maps velodyne points into the camera-0 frame), from
-    /// `Tr`, `Tr_velo_to_cam`, `Tr_velo_cam`, or `R` (9 numbers) with `T` (3 numbers).
+    /// `Tr`, `Tr_velo_to_cam`, `Tr_velo_cam`, or `R` (9 numbers) with `T` (3 numbers);
+    /// `None` when absent or when the numbers are not a rigid transform.
     pub fn cam0_from_velo(&self) -> Option<Pose3> {
         if let Some(m) = VELO_TO_CAM_KEYS.iter().find_map(|k| self.matrix3x4(k)) {
-            return Some(Pose3::from_matrix3x4(&m));
+            return Pose3::try_from_matrix3x4(&m);
         }
         let r = self.numeric.get("R").filter(|v| v.len() == 9)?;
         let t = self.numeric.get("T").filter(|v| v.len() == 3)?;
@@ -62,7 +63,7 @@ impl KittiCalib {
         m.fixed_view_mut::<3, 3>(0, 0)
             .copy_from(&Matrix3::from_row_slice(r));
         m.set_column(3, &Vector3::from_column_slice(t));
-        Some(Pose3::from_matrix3x4(&m))
+        Pose3::try_from_matrix3x4(&m)
     }
 }
 
