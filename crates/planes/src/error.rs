@@ -32,3 +32,14 @@ pub enum PlaneError {
         segmentation: usize,
     },
 }
+
+impl PlaneError {
+    /// `Ok` when `width × height` equals `len` and both are positive (an organized grid),
+    /// else [`PlaneError::NotOrganized`].
+    pub(crate) fn check_organized(width: usize, height: usize, len: usize) -> Result<(), Self> {
+        if width == 0 || height == 0 || width.checked_mul(height) != Some(len) {
+            return Err(Self::NotOrganized { width, height, len });
+        }
+        Ok(())
+    }
+}

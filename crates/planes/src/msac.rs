@@ -66,13 +66,7 @@ pub fn msac(
     height: usize,
     params: &MsacParams,
 ) -> Result<Segmentation, PlaneError> {
-    if width == 0 || height == 0 || width.checked_mul(height) != Some(points.len()) {
-        return Err(PlaneError::NotOrganized {
-            width,
-            height,
-            len: points.len(),
-        });
-    }
+    PlaneError::check_organized(width, height, points.len())?;
     if params.max_distance_m.is_nan() || params.max_distance_m <= 0.0 {
         return Err(PlaneError::Parameter {
             name: "max_distance_m",

@@ -201,13 +201,7 @@ pub fn peac(
     params: &PeacParams,
 ) -> Result<Segmentation, PlaneError> {
     params.validate()?;
-    if width == 0 || height == 0 || width.checked_mul(height) != Some(points.len()) {
-        return Err(PlaneError::NotOrganized {
-            width,
-            height,
-            len: points.len(),
-        });
-    }
+    PlaneError::check_organized(width, height, points.len())?;
     let range: Vec<f64> = points
         .iter()
         .map(|p| {

@@ -119,13 +119,7 @@ pub fn extract_grid(
     params: &PpeParams,
 ) -> Result<Segmentation, PlaneError> {
     params.validate()?;
-    if width == 0 || height == 0 || width.checked_mul(height) != Some(points.len()) {
-        return Err(PlaneError::NotOrganized {
-            width,
-            height,
-            len: points.len(),
-        });
-    }
+    PlaneError::check_organized(width, height, points.len())?;
     if points.len() >= NONE as usize {
         return Err(PlaneError::Parameter {
             name: "points",
