@@ -23,6 +23,7 @@
 //! | [`synpeb`] | rooms of polyhedral objects | organized 500 × 500, σ 1 mdeg, 0–4 cm | PCD, label in `intensity` | Schaefer ch. 11 |
 //! | [`urban`] | streets, facades, poles, trees, cars; sessions with changes | HDL-64E / HDL-32E ([`lidar3`]) | KITTI / NCLT layouts + poles | Schaefer ch. 12 |
 //! | [`semi_kitti`] | streets around a real KITTI drive and pole map | HDL-64E | KITTI layout + poles | Schaefer ch. 12 |
+//! | [`semi_nclt`] | a campus around the real NCLT pole layout and path; sessions with changes | HDL-32E | in memory (scans on demand) | Schaefer ch. 12 |
 //!
 //! [`datasets`] names the embedded default sets (`cargo xtask datasets generate`); the
 //! `raypath simulate` command runs any generator on user parameters.
@@ -61,6 +62,7 @@ pub mod rng;
 pub mod scene2;
 pub mod scene3;
 pub mod semi_kitti;
+pub mod semi_nclt;
 pub mod synpeb;
 pub mod urban;
 

@@ -8,7 +8,7 @@ use nalgebra::{Point2, Vector2};
 use rand::Rng;
 
 use super::kinds::PoleKind;
-use super::streets::{UrbanLayout, sample};
+use super::streets::{ConstructionZone, ParkingSlot, UrbanLayout, sample};
 use super::world::{Barrel, Car, Footprint, PoleObject, World};
 use crate::rng::{self, SimRng};
 
@@ -93,8 +93,28 @@ pub fn session_worlds(
     changes: &SessionChanges,
     seed: u64,
 ) -> Vec<(World, ChangeLog)> {
+    session_worlds_of(
+        &layout.world,
+        &layout.parking,
+        &layout.construction,
+        months,
+        changes,
+        seed,
+    )
+}
+
+/// [`session_worlds`] of a static world (no cars or barrels) with its parking slots and
+/// construction zones, for worlds not built from a street grid.
+pub(crate) fn session_worlds_of(
+    base: &World,
+    parking: &[ParkingSlot],
+    construction: &[ConstructionZone],
+    months: &[u32],
+    changes: &SessionChanges,
+    seed: u64,
+) -> Vec<(World, ChangeLog)> {
     let mut out: Vec<(World, ChangeLog)> = Vec::with_capacity(months.len());
-    let mut poles = layout.world.poles.clone();
+    let mut poles = base.poles.clone();
     let mut next_id = poles.iter().map(|p| p.pole.id + 1).max().unwrap_or(0);
     for (k, &month) in months.iter().enumerate() {
         let mut rng = rng::stream(seed, DOMAIN_SESSION, k as u64);
@@ -105,13 +125,13 @@ pub fn session_worlds(
         if k > 0 {
             change_poles(&mut poles, &mut next_id, changes, &mut rng, &mut log);
         }
-        let mut world = layout.world.clone();
+        let mut world = base.clone();
         world.poles = poles.clone();
         world.foliage = log.foliage;
         let mut car_rng = rng::stream(seed, DOMAIN_CARS, k as u64);
-        world.cars = park_cars(layout, changes, &mut car_rng);
+        world.cars = park_cars(parking, changes, &mut car_rng);
         log.parked_cars = world.cars.len();
-        for zone in &layout.construction {
+        for zone in construction {
             let shift = if k == 0 {
                 Some(0.0)
             } else if rng.random_bool(changes.barrels_absent_probability) {
@@ -239,10 +259,10 @@ fn change_poles(
 }
 
 /// Cars in a random subset of the parking slots.
-fn park_cars(layout: &UrbanLayout, changes: &SessionChanges, rng: &mut SimRng) -> Vec<Car> {
+fn park_cars(parking: &[ParkingSlot], changes: &SessionChanges, rng: &mut SimRng) -> Vec<Car> {
     let occupancy = sample(rng, changes.parking_occupancy).clamp(0.0, 1.0);
     let mut cars = Vec::new();
-    for slot in &layout.parking {
+    for slot in parking {
         if !rng.random_bool(occupancy) {
             continue;
         }
