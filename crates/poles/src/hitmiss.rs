@@ -1,10 +1,16 @@
 //! The local 3-D grid of hit and miss counts, filled by exact ray traversal (spec §3.1,
 //! `acschaefer/ray_tracing`): every voxel a ray crosses gets a miss; when the endpoint lies
 //! inside the grid, the last voxel's miss becomes a hit. Rays are clipped to the grid.
+//!
+//! The walk is [`Tracer`](crate::tracer), a copy of `Grid3::traverse`'s arithmetic reduced
+//! to linear-index stepping (same voxels, tested against it); the cost is linear in the
+//! voxels crossed (about 120 per ray of a KITTI local map).
 
-use nalgebra::{Point3, Unit};
+use nalgebra::Point3;
 use rayon::prelude::*;
 use raypath_geometry::{Grid3, PointCloud, Pose3};
+
+use crate::tracer::Tracer;
 
 /// Hit and miss counts per voxel of a [`Grid3`] (linear index, x fastest), saturating
 /// `u16` (half the memory traffic of `u32`; a voxel with 65535 misses is free anyway).
@@ -51,13 +57,7 @@ impl HitMissGrid {
     /// Traces one ray from `origin` to `endpoint` (world frame).
     #[inline]
     pub fn insert_ray(&mut self, origin: &Point3<f64>, endpoint: &Point3<f64>) {
-        trace(
-            &self.grid,
-            &mut self.hits,
-            &mut self.misses,
-            origin,
-            endpoint,
-        );
+        Tracer::new(&self.grid).trace(&mut self.hits, &mut self.misses, origin, endpoint);
         self.rays += 1;
     }
 
@@ -82,7 +82,7 @@ impl HitMissGrid {
             }
         }
         let n = self.grid.num_cells();
-        let grid = &self.grid;
+        let tracer = Tracer::new(&self.grid);
         let per_thread = items.len().div_ceil(threads).max(1);
         let max_sq = max_range_m * max_range_m;
         let partials: Vec<(Vec<u16>, Vec<u16>, u64)> = items
@@ -108,7 +108,7 @@ impl HitMissGrid {
                             continue;
                         }
                         let endpoint = pose.transform_point(&local);
-                        trace(grid, &mut hits, &mut misses, &origin, &endpoint);
+                        tracer.trace(&mut hits, &mut misses, &origin, &endpoint);
                         rays += 1;
                     }
                 }
@@ -132,40 +132,6 @@ fn add_into(total: &mut [u16], part: &[u16]) {
                 *a = a.saturating_add(*b);
             }
         });
-}
-
-/// Traces one ray into count arrays of `grid`.
-#[inline]
-fn trace(
-    grid: &Grid3,
-    hits: &mut [u16],
-    misses: &mut [u16],
-    origin: &Point3<f64>,
-    endpoint: &Point3<f64>,
-) {
-    let delta = endpoint - origin;
-    let length = delta.norm();
-    if !(length > 0.0 && length.is_finite()) {
-        return;
-    }
-    let direction = Unit::new_unchecked(delta / length);
-    let mut last = None;
-    grid.traverse(origin, &direction, length).for_each(|c| {
-        if let Some(m) = misses.get_mut(c.index) {
-            *m = m.saturating_add(1);
-        }
-        last = Some(c.index);
-    });
-    if let (Some(index), Some(cell)) = (last, grid.cell_of(endpoint))
-        && grid.linear_index(cell) == index
-    {
-        if let Some(m) = misses.get_mut(index) {
-            *m = m.saturating_sub(1);
-        }
-        if let Some(h) = hits.get_mut(index) {
-            *h = h.saturating_add(1);
-        }
-    }
 }
 
 #[cfg(test)]

@@ -106,6 +106,7 @@ mod pipeline;
 mod pole;
 mod pole_map;
 mod score;
+mod tracer;
 
 pub use beta::ReflectionPrior;
 pub use drive::{Drive, DriveFormat};

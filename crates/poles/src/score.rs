@@ -79,6 +79,8 @@ struct SliceWork {
     /// `max_{dy<span} cols_f(x, y + dy)`: the vertical hull strips, grown with the span.
     strip_v: Vec<f32>,
     raw: Vec<f32>,
+    /// Anchors (linear index in the slice) with a positive raw score, for the current width.
+    positive: Vec<usize>,
     q: Vec<f32>,
 }
 
@@ -91,6 +93,25 @@ fn grow(acc: &mut [f32], src: &[f32], shift: usize) {
     }
     for (a, s) in acc.iter_mut().zip(&src[shift..]) {
         *a = a.max(*s);
+    }
+}
+
+/// `q(j) = max raw(k)` over the `positive` anchors `k` whose `a × a` footprint
+/// `[kx, kx + a) × [ky, ky + a)` contains `j`, −1 where none does: the positive part of the
+/// rectangle maximum, for footprints inside the slice.
+fn scatter_max(raw: &[f32], positive: &[usize], nx: usize, a: usize, q: &mut [f32]) {
+    q.fill(-1.0);
+    for &anchor in positive {
+        let Some(&r) = raw.get(anchor) else {
+            continue;
+        };
+        for dy in 0..a {
+            if let Some(row) = q.get_mut(anchor + dy * nx..anchor + dy * nx + a) {
+                for v in row {
+                    *v = v.max(r);
+                }
+            }
+        }
     }
 }
 
@@ -146,7 +167,7 @@ impl SliceWork {
             grow(&mut self.strip_h, &self.rows_f, span - 1);
             grow(&mut self.strip_v, &self.cols_f, (span - 1) * nx);
             self.raw.fill(-1.0);
-            let mut any_positive = false;
+            self.positive.clear();
             let inv_area = 1.0 / (a * a) as f64;
             // Anchors kx ∈ [f, nx − a − f] of row ky, as zipped row slices (no index checks in
             // the loop; vectorizable).
@@ -160,31 +181,48 @@ impl SliceWork {
                 let left = &self.strip_v[(ky - f) * nx..][..count];
                 let right = &self.strip_v[(ky - f) * nx + f + a..][..count];
                 let out = &mut self.raw[ky * nx + f..][..count];
+                let mut row_positive = false;
                 for (i, o) in out.iter_mut().enumerate() {
                     // Box sum over [kx, kx + a) × [ky, ky + a) from the summed-area table.
                     let inside = (t1[i + a] - t1[i] - t0[i + a] + t0[i]) * inv_area;
                     let hull = below[i].max(above[i]).max(left[i]).max(right[i]);
                     let raw = inside as f32 - hull;
-                    any_positive |= raw > 0.0;
+                    row_positive |= raw > 0.0;
                     *o = raw;
                 }
+                if row_positive {
+                    let row = ky * nx + f;
+                    self.positive.extend(
+                        out.iter()
+                            .enumerate()
+                            .filter(|&(_, &r)| r > 0.0)
+                            .map(|(i, _)| row + i),
+                    );
+                }
             }
-            if !any_positive {
+            if self.positive.is_empty() {
                 // No placement with evidence for a pole: every q'_a ≤ 1/2 is stored as 0.
                 continue;
             }
             // q_a(j): best placement whose a × a footprint contains j (anchors j−a+1 ..= j).
-            let lo = -(a as isize - 1);
-            rect_max(
-                &self.raw,
-                nx,
-                ny,
-                (lo, a),
-                (lo, a),
-                -1.0,
-                &mut self.q,
-                &mut self.scratch,
-            );
+            // Only q_a > 0 is used, i.e. the maximum over the positive anchors: scattered
+            // from them when they are few (typical: poles are sparse), else the separable
+            // rectangle maximum over the whole slice.
+            if self.positive.len() * a * a < n / 4 {
+                scatter_max(&self.raw, &self.positive, nx, a, &mut self.q);
+            } else {
+                let lo = -(a as isize - 1);
+                rect_max(
+                    &self.raw,
+                    nx,
+                    ny,
+                    (lo, a),
+                    (lo, a),
+                    -1.0,
+                    &mut self.q,
+                    &mut self.scratch,
+                );
+            }
             let Some(bytes) = per_a.get_mut(a - 1) else {
                 continue;
             };
@@ -193,6 +231,53 @@ impl SliceWork {
                     let remapped = 0.5 * q + 0.5; // errata 12: q' = q/2 + 1/2
                     *b = b.max(remapped);
                     *out = (remapped.min(1.0) * 255.0).round() as u8;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scattered_maxima_equal_the_rectangle_maximum_where_positive() {
+        let (nx, ny) = (23, 17);
+        for (a, density) in [(1, 3), (2, 5), (3, 11), (5, 40)] {
+            // Raw scores in [−1, 1): positive at about one anchor in `density`, and only at
+            // anchors whose footprint lies inside the slice (as in `score_slice`).
+            let raw: Vec<f32> = (0..nx * ny)
+                .map(|i| {
+                    let (x, y) = (i % nx, i / nx);
+                    let v = ((i * 7919 + 13) % 1000) as f32 / 1000.0;
+                    if x + a <= nx && y + a <= ny && (i * 31) % density == 0 {
+                        v
+                    } else {
+                        -v
+                    }
+                })
+                .collect();
+            let positive: Vec<usize> = (0..raw.len()).filter(|&i| raw[i] > 0.0).collect();
+            assert!(!positive.is_empty());
+            let mut scattered = vec![0.0; nx * ny];
+            scatter_max(&raw, &positive, nx, a, &mut scattered);
+            let mut dense = vec![0.0; nx * ny];
+            let lo = -(a as isize - 1);
+            let mut scratch = Scratch::default();
+            rect_max(
+                &raw,
+                nx,
+                ny,
+                (lo, a),
+                (lo, a),
+                -1.0,
+                &mut dense,
+                &mut scratch,
+            );
+            for (j, (&s, &d)) in scattered.iter().zip(&dense).enumerate() {
+                if d > 0.0 || s > 0.0 {
+                    assert_eq!(s, d, "a {a} voxel {j}");
                 }
             }
         }
