@@ -62,65 +62,95 @@ impl HitMissGrid {
     }
 
     /// Traces every valid point of every scan (`world_from_sensor`, points in the sensor
-    /// frame) from the sensor position, in parallel: one partial grid per thread, summed.
-    /// Points farther than `max_range_m` from the sensor are skipped.
+    /// frame) from the sensor position, in parallel: the points are split into one
+    /// contiguous, equal share per thread; the first share is counted into this grid, the
+    /// others into partial grids that are then added (saturating; the counts equal those of
+    /// sequential insertion unless a voxel saturates). Points farther than `max_range_m` from
+    /// the sensor are skipped.
     pub fn insert_scans_par(&mut self, scans: &[(Pose3, &PointCloud)], max_range_m: f64) {
-        // Work items: (scan, first point, end point), a few per thread.
         let total: usize = scans.iter().map(|(_, c)| c.len()).sum();
         if total == 0 {
             return;
         }
         let threads = rayon::current_num_threads().max(1);
-        let chunk = total.div_ceil(threads);
-        let mut items = Vec::new();
-        for (s, (_, cloud)) in scans.iter().enumerate() {
-            let mut start = 0;
-            while start < cloud.len() {
-                let end = (start + chunk.max(1)).min(cloud.len());
-                items.push((s, start, end));
-                start = end;
-            }
-        }
+        let shares = split_points(scans, total.div_ceil(threads).max(1));
+        let Some((first, rest)) = shares.split_first() else {
+            return;
+        };
         let n = self.grid.num_cells();
         let tracer = Tracer::new(&self.grid);
-        let per_thread = items.len().div_ceil(threads).max(1);
         let max_sq = max_range_m * max_range_m;
-        let partials: Vec<(Vec<u16>, Vec<u16>, u64)> = items
-            .par_chunks(per_thread)
-            .map(|work| {
-                let mut hits = vec![0u16; n];
-                let mut misses = vec![0u16; n];
-                let mut rays = 0u64;
-                for &(s, start, end) in work {
-                    let Some((pose, cloud)) = scans.get(s) else {
+        let trace_share = |share: &[Piece], hits: &mut [u16], misses: &mut [u16]| -> u64 {
+            let mut rays = 0u64;
+            for &(s, start, end) in share {
+                let Some((pose, cloud)) = scans.get(s) else {
+                    continue;
+                };
+                let origin = Point3::from(pose.translation());
+                let Some(points) = cloud.points.get(start..end) else {
+                    continue;
+                };
+                for p in points {
+                    if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
                         continue;
-                    };
-                    let origin = Point3::from(pose.translation());
-                    let Some(points) = cloud.points.get(start..end) else {
-                        continue;
-                    };
-                    for p in points {
-                        if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
-                            continue;
-                        }
-                        let local = Point3::new(p.x as f64, p.y as f64, p.z as f64);
-                        if local.coords.norm_squared() > max_sq {
-                            continue;
-                        }
-                        let endpoint = pose.transform_point(&local);
-                        tracer.trace(&mut hits, &mut misses, &origin, &endpoint);
-                        rays += 1;
                     }
+                    let local = Point3::new(p.x as f64, p.y as f64, p.z as f64);
+                    if local.coords.norm_squared() > max_sq {
+                        continue;
+                    }
+                    let endpoint = pose.transform_point(&local);
+                    tracer.trace(hits, misses, &origin, &endpoint);
+                    rays += 1;
                 }
-                (hits, misses, rays)
-            })
-            .collect();
+            }
+            rays
+        };
+        let (hits, misses) = (&mut self.hits, &mut self.misses);
+        let (rays, partials) = rayon::join(
+            || trace_share(first, hits, misses),
+            || {
+                rest.par_iter()
+                    .map(|share| {
+                        let (mut hits, mut misses) = (vec![0u16; n], vec![0u16; n]);
+                        let rays = trace_share(share, &mut hits, &mut misses);
+                        (hits, misses, rays)
+                    })
+                    .collect::<Vec<_>>()
+            },
+        );
+        self.rays += rays;
         for (hits, misses, rays) in partials {
             add_into(&mut self.hits, &hits);
             add_into(&mut self.misses, &misses);
             self.rays += rays;
         }
     }
+}
+
+/// Points `start..end` of scan `s`.
+type Piece = (usize, usize, usize);
+
+/// Splits the points of all scans, in order, into shares of `share` points (the last one
+/// shorter), each a list of pieces of scans.
+fn split_points(scans: &[(Pose3, &PointCloud)], share: usize) -> Vec<Vec<Piece>> {
+    let mut shares = vec![Vec::new()];
+    let mut room = share;
+    for (s, (_, cloud)) in scans.iter().enumerate() {
+        let mut start = 0;
+        while start < cloud.len() {
+            if room == 0 {
+                shares.push(Vec::new());
+                room = share;
+            }
+            let end = (start + room).min(cloud.len());
+            if let Some(last) = shares.last_mut() {
+                last.push((s, start, end));
+            }
+            room -= end - start;
+            start = end;
+        }
+    }
+    shares
 }
 
 fn add_into(total: &mut [u16], part: &[u16]) {
@@ -173,5 +203,35 @@ mod tests {
         assert_eq!(par.hits(), seq.hits());
         assert_eq!(par.misses(), seq.misses());
         assert_eq!(par.rays(), 500);
+    }
+
+    #[test]
+    fn shares_cover_every_point_once_in_order() {
+        let clouds: Vec<PointCloud> = [3usize, 0, 7, 5]
+            .iter()
+            .map(|&n| PointCloud::from_points(vec![Point3::new(1.0f32, 0.0, 0.0); n]))
+            .collect();
+        let scans: Vec<(Pose3, &PointCloud)> = clouds
+            .iter()
+            .map(|c| (Pose3::from_xyz_rpy(0.0, 0.0, 0.0, 0.0, 0.0, 0.0), c))
+            .collect();
+        let shares = split_points(&scans, 4);
+        let sizes: Vec<usize> = shares
+            .iter()
+            .map(|s| s.iter().map(|&(_, a, b)| b - a).sum())
+            .collect();
+        assert_eq!(sizes, [4, 4, 4, 3]);
+        let pieces: Vec<Piece> = shares.concat();
+        assert_eq!(
+            pieces,
+            [
+                (0, 0, 3),
+                (2, 0, 1),
+                (2, 1, 5),
+                (2, 5, 7),
+                (3, 0, 2),
+                (3, 2, 5)
+            ]
+        );
     }
 }

@@ -38,6 +38,30 @@ impl ScoreVolume {
 /// Computes the scores of an occupancy volume (`occupancy` per voxel, x fastest) with widths
 /// `1..=widths` and hull thickness `hull` cells. Slices are scored in parallel.
 pub fn pole_scores(occupancy: &[f32], dims: [usize; 3], widths: usize, hull: usize) -> ScoreVolume {
+    pole_scores_with(occupancy, dims, widths, hull, Path::Auto)
+}
+
+/// How `q_a` is computed from the raw scores.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+enum Path {
+    /// Scattered from the positive anchors when they cover less than a quarter of the slice.
+    #[default]
+    Auto,
+    /// Always scattered (tests).
+    #[cfg(test)]
+    Sparse,
+    /// Always the rectangle maximum over the slice (tests).
+    #[cfg(test)]
+    Dense,
+}
+
+fn pole_scores_with(
+    occupancy: &[f32],
+    dims: [usize; 3],
+    widths: usize,
+    hull: usize,
+    path: Path,
+) -> ScoreVolume {
     let [nx, ny, nz] = dims;
     let n_slice = nx * ny;
     let n = n_slice * nz;
@@ -55,9 +79,15 @@ pub fn pole_scores(occupancy: &[f32], dims: [usize; 3], widths: usize, hull: usi
     best.par_chunks_mut(n_slice)
         .zip(occupancy.par_chunks(n_slice))
         .zip(width_slices.into_par_iter())
-        .for_each_init(SliceWork::default, |work, ((best, occ), mut per_a)| {
-            work.score_slice(occ, nx, ny, widths, hull, best, &mut per_a);
-        });
+        .for_each_init(
+            || SliceWork {
+                path,
+                ..SliceWork::default()
+            },
+            |work, ((best, occ), mut per_a)| {
+                work.score_slice(occ, nx, ny, widths, hull, best, &mut per_a);
+            },
+        );
     ScoreVolume {
         dims,
         widths,
@@ -82,6 +112,7 @@ struct SliceWork {
     /// Anchors (linear index in the slice) with a positive raw score, for the current width.
     positive: Vec<usize>,
     q: Vec<f32>,
+    path: Path,
 }
 
 /// `acc(i) = max(acc(i), src(i + shift))` where `i + shift` is inside (a running window
@@ -97,18 +128,50 @@ fn grow(acc: &mut [f32], src: &[f32], shift: usize) {
 }
 
 /// `q(j) = max raw(k)` over the `positive` anchors `k` whose `a × a` footprint
-/// `[kx, kx + a) × [ky, ky + a)` contains `j`, −1 where none does: the positive part of the
-/// rectangle maximum, for footprints inside the slice.
+/// `[kx, kx + a) × [ky, ky + a)` contains `j`, written to the footprints only (other entries
+/// of `q` are left as they are): the positive part of the rectangle maximum, for footprints
+/// inside the slice.
 fn scatter_max(raw: &[f32], positive: &[usize], nx: usize, a: usize, q: &mut [f32]) {
-    q.fill(-1.0);
+    for_footprints(positive, nx, a, q, |_, v| *v = -1.0);
     for &anchor in positive {
         let Some(&r) = raw.get(anchor) else {
             continue;
         };
+        for_footprints(&[anchor], nx, a, q, |_, v| *v = v.max(r));
+    }
+}
+
+/// Calls `f(index, &mut q[index])` for every voxel of the `a × a` footprints of `anchors`
+/// (a voxel of overlapping footprints once per footprint).
+#[inline]
+fn for_footprints<T>(
+    anchors: &[usize],
+    nx: usize,
+    a: usize,
+    q: &mut [T],
+    mut f: impl FnMut(usize, &mut T),
+) {
+    for &anchor in anchors {
         for dy in 0..a {
-            if let Some(row) = q.get_mut(anchor + dy * nx..anchor + dy * nx + a) {
-                for v in row {
-                    *v = v.max(r);
+            let start = anchor + dy * nx;
+            if let Some(row) = q.get_mut(start..start + a) {
+                for (i, v) in row.iter_mut().enumerate() {
+                    f(start + i, v);
+                }
+            }
+        }
+    }
+}
+
+/// Sets `raw` to −1 outside the anchors `[lo, hi_x] × [lo, hi_y]` of a slice `nx` wide.
+fn clear_outside(raw: &mut [f32], nx: usize, lo: usize, hi_x: usize, hi_y: usize) {
+    for (y, row) in raw.chunks_exact_mut(nx).enumerate() {
+        if y < lo || y > hi_y {
+            row.fill(-1.0);
+        } else {
+            for (x, v) in row.iter_mut().enumerate() {
+                if x < lo || x > hi_x {
+                    *v = -1.0;
                 }
             }
         }
@@ -128,10 +191,7 @@ impl SliceWork {
         per_a: &mut [&mut [u8]],
     ) {
         let n = nx * ny;
-        best.fill(0.0);
-        for s in per_a.iter_mut() {
-            s.fill(0);
-        }
+        // `best` and `per_a` arrive zeroed (fresh pages stay untouched where nothing scores).
         // A slice without occupied voxels cannot hold a pole (the inside mean is ≈ 0).
         if occ.iter().all(|&o| o < 0.05) || 1 + 2 * f > nx || 1 + 2 * f > ny {
             return;
@@ -166,7 +226,6 @@ impl SliceWork {
             }
             grow(&mut self.strip_h, &self.rows_f, span - 1);
             grow(&mut self.strip_v, &self.cols_f, (span - 1) * nx);
-            self.raw.fill(-1.0);
             self.positive.clear();
             let inv_area = 1.0 / (a * a) as f64;
             // Anchors kx ∈ [f, nx − a − f] of row ky, as zipped row slices (no index checks in
@@ -208,9 +267,33 @@ impl SliceWork {
             // Only q_a > 0 is used, i.e. the maximum over the positive anchors: scattered
             // from them when they are few (typical: poles are sparse), else the separable
             // rectangle maximum over the whole slice.
-            if self.positive.len() * a * a < n / 4 {
+            let Some(bytes) = per_a.get_mut(a - 1) else {
+                continue;
+            };
+            let update = |b: &mut f32, q: f32, out: &mut u8| {
+                if q > 0.0 {
+                    let remapped = 0.5 * q + 0.5; // errata 12: q' = q/2 + 1/2
+                    *b = b.max(remapped);
+                    *out = (remapped.min(1.0) * 255.0).round() as u8;
+                }
+            };
+            let sparse = match self.path {
+                Path::Auto => self.positive.len() * a * a < n / 4,
+                #[cfg(test)]
+                Path::Sparse => true,
+                #[cfg(test)]
+                Path::Dense => false,
+            };
+            if sparse {
                 scatter_max(&self.raw, &self.positive, nx, a, &mut self.q);
+                let q = &self.q;
+                for_footprints(&self.positive, nx, a, best, |j, b| {
+                    if let (Some(&q), Some(out)) = (q.get(j), bytes.get_mut(j)) {
+                        update(b, q, out);
+                    }
+                });
             } else {
+                clear_outside(&mut self.raw, nx, f, nx - a - f, ny - a - f);
                 let lo = -(a as isize - 1);
                 rect_max(
                     &self.raw,
@@ -222,15 +305,8 @@ impl SliceWork {
                     &mut self.q,
                     &mut self.scratch,
                 );
-            }
-            let Some(bytes) = per_a.get_mut(a - 1) else {
-                continue;
-            };
-            for ((b, &q), out) in best.iter_mut().zip(&self.q).zip(bytes.iter_mut()) {
-                if q > 0.0 {
-                    let remapped = 0.5 * q + 0.5; // errata 12: q' = q/2 + 1/2
-                    *b = b.max(remapped);
-                    *out = (remapped.min(1.0) * 255.0).round() as u8;
+                for ((b, &q), out) in best.iter_mut().zip(&self.q).zip(bytes.iter_mut()) {
+                    update(b, q, out);
                 }
             }
         }
@@ -240,6 +316,39 @@ impl SliceWork {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sparse_and_dense_paths_give_the_same_scores() {
+        // Occupancy with isolated occupied voxels and blocks (poles of several widths), a
+        // wall, and pseudo-random clutter; the sparse path is taken for some widths and
+        // slices in `Auto`, so compare all three.
+        let dims = [40, 33, 4];
+        let occupancy: Vec<f32> = (0..dims[0] * dims[1] * dims[2])
+            .map(|i| {
+                let (x, y, z) = (
+                    i % dims[0],
+                    (i / dims[0]) % dims[1],
+                    i / (dims[0] * dims[1]),
+                );
+                let pole = (x % 9 < 1 + z % 3) && (y % 8 < 1 + (x / 9) % 3);
+                let wall = y == 30;
+                let clutter = ((i * 2654435761) >> 7) % 97;
+                if pole || wall {
+                    0.9 + (clutter % 10) as f32 * 0.01
+                } else {
+                    clutter as f32 / 400.0
+                }
+            })
+            .collect();
+        for hull in [1, 2] {
+            let auto = pole_scores_with(&occupancy, dims, 6, hull, Path::Auto);
+            let sparse = pole_scores_with(&occupancy, dims, 6, hull, Path::Sparse);
+            let dense = pole_scores_with(&occupancy, dims, 6, hull, Path::Dense);
+            assert!(dense.best.iter().filter(|&&b| b > 0.6).count() > 50);
+            assert_eq!(auto, dense, "hull {hull}");
+            assert_eq!(sparse, dense, "hull {hull}");
+        }
+    }
 
     #[test]
     fn scattered_maxima_equal_the_rectangle_maximum_where_positive() {
@@ -260,7 +369,7 @@ mod tests {
                 .collect();
             let positive: Vec<usize> = (0..raw.len()).filter(|&i| raw[i] > 0.0).collect();
             assert!(!positive.is_empty());
-            let mut scattered = vec![0.0; nx * ny];
+            let mut scattered = vec![-1.0; nx * ny];
             scatter_max(&raw, &positive, nx, a, &mut scattered);
             let mut dense = vec![0.0; nx * ny];
             let lo = -(a as isize - 1);
