@@ -321,3 +321,14 @@ fn empty_and_comment_only_logs_have_no_records() {
     assert!(read("").is_empty());
     assert!(read("# nothing\n\n   \n#PARAM x\n").is_empty());
 }
+
+#[test]
+fn front_lasers_skip_odometry_and_rear_lasers() {
+    let reader = CarmenReader::new(Cursor::new(LOG.as_bytes().to_vec()), "mem.log");
+    let kinds: Vec<&str> = reader
+        .front_lasers()
+        .map(|m| m.unwrap().kind.tag())
+        .collect();
+    // FLASER and ROBOTLASER1 are front lasers; RLASER, ODOM, PARAM and NEFF are skipped.
+    assert_eq!(kinds, ["FLASER", "ROBOTLASER1"]);
+}

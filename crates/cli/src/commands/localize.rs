@@ -16,7 +16,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use raypath_geometry::Pose2;
-use raypath_io::carmen::{CarmenReader, LaserKind, Record};
+use raypath_io::carmen::CarmenReader;
 use raypath_localizer::eval::{EvaluationConfig, evaluate_trajectory};
 use raypath_localizer::init::GaussianInit;
 use raypath_localizer::lidar::{
@@ -80,20 +80,18 @@ type LogScan = (f64, Pose2, Pose2, raypath_geometry::Scan2);
 
 fn read_log(path: &Path, json: bool) -> Result<Vec<LogScan>, Failure> {
     let reader = CarmenReader::open(path).map_err(|e| Failure::input(e, json))?;
-    let mut out = Vec::new();
-    for record in reader {
-        if let Record::Laser(m) = record.map_err(|e| Failure::input(e, json))?
-            && m.kind != LaserKind::Rear
-        {
-            out.push((
+    reader
+        .front_lasers()
+        .map(|m| {
+            let m = m.map_err(|e| Failure::input(e, json))?;
+            Ok((
                 m.logger_timestamp_secs,
                 m.world_from_robot,
                 m.world_from_laser,
                 m.scan,
-            ));
-        }
-    }
-    Ok(out)
+            ))
+        })
+        .collect()
 }
 
 /// Reads a TUM file `t x y z qx qy qz qw` (comments `#`), keeping x, y and the yaw.
@@ -169,17 +167,18 @@ fn read_ground_truth(
     json: bool,
 ) -> Result<Vec<(f64, Pose2)>, Failure> {
     let carmen = CarmenReader::open(path).ok().and_then(|reader| {
-        let mut out = Vec::new();
-        for record in reader {
-            match record {
-                Ok(Record::Laser(m)) if m.kind != LaserKind::Rear => out.push((
-                    m.logger_timestamp_secs,
-                    m.world_from_laser * robot_from_laser.inverse(),
-                )),
-                Ok(_) => {}
-                Err(_) => return None,
-            }
-        }
+        let out: Vec<(f64, Pose2)> = reader
+            .front_lasers()
+            .map(|m| {
+                m.map(|m| {
+                    (
+                        m.logger_timestamp_secs,
+                        m.world_from_laser * robot_from_laser.inverse(),
+                    )
+                })
+            })
+            .collect::<Result<_, _>>()
+            .ok()?;
         (!out.is_empty()).then_some(out)
     });
     let mut poses = match carmen {

@@ -366,20 +366,19 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
             });
         }
     }
+    // The keys every answer carries; `summary` is null without ground truth.
+    let mut answer = json!({
+        "sequence": c.sequence.display().to_string(),
+        "map": args.map.display().to_string(),
+        "preset": preset_name(c, &drive),
+        "runs": args.runs,
+        "summary": null,
+    });
     if runs.is_empty() {
         // No ground truth: report the final estimates only.
         if json {
-            println!(
-                "{}",
-                json!({
-                    "sequence": c.sequence.display().to_string(),
-                    "map": args.map.display().to_string(),
-                    "preset": preset_name(c, &drive),
-                    "runs": args.runs,
-                    "summary": null,
-                    "final_poses": finals,
-                })
-            );
+            answer["final_poses"] = finals.into();
+            println!("{answer}");
         } else {
             println!(
                 "{}: {} run(s), no ground truth; final poses: {}",
@@ -403,17 +402,9 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
                 })
             })
             .collect();
-        println!(
-            "{}",
-            json!({
-                "sequence": c.sequence.display().to_string(),
-                "map": args.map.display().to_string(),
-                "preset": preset_name(c, &drive),
-                "runs": args.runs,
-                "summary": summary,
-                "per_run": per_run,
-            })
-        );
+        answer["summary"] = summary;
+        answer["per_run"] = per_run.into();
+        println!("{answer}");
     } else {
         println!(
             "{}: {} run(s) on {} map poles",

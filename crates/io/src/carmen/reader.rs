@@ -288,6 +288,19 @@ impl CarmenReader {
     }
 }
 
+impl CarmenReader {
+    /// The laser messages of the front (or only) laser in file order, skipping odometry and
+    /// rear-laser records; errors pass through. The usual input of 2-D mapping and
+    /// localization.
+    pub fn front_lasers(self) -> impl Iterator<Item = Result<LaserMessage>> {
+        self.filter_map(|record| match record {
+            Ok(Record::Laser(m)) if m.kind != LaserKind::Rear => Some(Ok(m)),
+            Ok(_) => None,
+            Err(e) => Some(Err(e)),
+        })
+    }
+}
+
 impl Iterator for CarmenReader {
     type Item = Result<Record>;
 

@@ -7,7 +7,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use nalgebra::{Point2, Vector2};
 use raypath_geometry::{Aabb2, Grid2, Pose2, Scan2};
-use raypath_io::carmen::{CarmenReader, LaserKind, Record};
+use raypath_io::carmen::CarmenReader;
 use raypath_localizer::eval::{EvaluationConfig, evaluate_trajectory};
 use raypath_localizer::init::{GaussianInit, Initializer};
 use raypath_localizer::lidar::{
@@ -45,18 +45,14 @@ pub struct PlanarProblem {
 fn read_scans(path: &Path) -> Result<Vec<(f64, Pose2, Pose2, Scan2)>> {
     let reader = CarmenReader::open(path).with_context(|| format!("opening {}", path.display()))?;
     let mut out = Vec::new();
-    for record in reader {
-        if let Record::Laser(m) = record? {
-            if m.kind == LaserKind::Rear {
-                continue;
-            }
-            out.push((
-                m.logger_timestamp_secs,
-                m.world_from_robot,
-                m.world_from_laser,
-                m.scan,
-            ));
-        }
+    for m in reader.front_lasers() {
+        let m = m?;
+        out.push((
+            m.logger_timestamp_secs,
+            m.world_from_robot,
+            m.world_from_laser,
+            m.scan,
+        ));
     }
     Ok(out)
 }
