@@ -44,7 +44,9 @@ pub fn pole_scores(occupancy: &[f32], dims: [usize; 3], widths: usize, hull: usi
 /// How `q_a` is computed from the raw scores.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 enum Path {
-    /// Scattered from the positive anchors when they cover less than a quarter of the slice.
+    /// Scattered from the positive anchors when their footprints have fewer voxels than two
+    /// slices (the scatter touches each footprint voxel three times, the rectangle maximum
+    /// every voxel of the slice about ten times).
     #[default]
     Auto,
     /// Always scattered (tests).
@@ -278,7 +280,7 @@ impl SliceWork {
                 }
             };
             let sparse = match self.path {
-                Path::Auto => self.positive.len() * a * a < n / 4,
+                Path::Auto => self.positive.len() * a * a < 2 * n,
                 #[cfg(test)]
                 Path::Sparse => true,
                 #[cfg(test)]

@@ -149,8 +149,11 @@ impl Tracer {
             return false;
         }
         let clipped_at_end = t_end < length;
-        let axes =
-            [0, 1, 2].map(|axis| self.axis(axis, o[axis], d[axis], t_start, t_end, clipped_at_end));
+        let axes = [
+            self.axis(0, o[0], d[0], t_start, t_end, clipped_at_end),
+            self.axis(1, o[1], d[1], t_start, t_end, clipped_at_end),
+            self.axis(2, o[2], d[2], t_start, t_end, clipped_at_end),
+        ];
         let last = self.walk(misses, &axes, t_end);
         // The hit: the endpoint's voxel (`Grid3::cell_of`) is the last one crossed.
         if let Some(end_index) = self.index_of(endpoint)
