@@ -34,6 +34,24 @@ impl Default for Selection {
     }
 }
 
+/// Which cells may fuse into one cuboid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum FusionRule {
+    /// The thesis' rule (Khan 2017, §2.5.2): only cells clamped at the same bound
+    /// (`μ_min` or `μ_max`) fuse; the fused cell takes the mean of its cells. Updates of a
+    /// fused cell apply to the whole cuboid unless [`GridConfig::split_on_unclamp`] is set.
+    #[default]
+    Clamped,
+    /// Our extension beyond Khan 2017, in the spirit of OctoMap's pruning (which merges 8
+    /// siblings with equal log-odds) but with cuboids: cells whose log-odds are bit-equal
+    /// `f32`s fuse, clamped or not, with the same search-direction order. The map stays
+    /// exact: an update that changes the value of only part of a fused cell splits it
+    /// (the changed base cubes, plus the fewest halving cuboids covering the rest with the
+    /// old value) before the per-cube updates apply, so every base cube carries the log-odds
+    /// an unfused lattice would (`split_on_unclamp` is implied).
+    EqualValue,
+}
+
 /// Configuration of an [`RtreeGrid`](crate::RtreeGrid).
 ///
 /// Defaults are the thesis' (§2.6, "same as in OctoMap"): `P_occ = 0.7`, `P_free = 0.4`,
@@ -72,6 +90,8 @@ pub struct GridConfig {
     /// Split a fused cell back into base cubes when an update would take it out of the
     /// clamped state (the thesis' future work for dynamic scenes, §2.7); off in the thesis.
     pub split_on_unclamp: bool,
+    /// Which cells may fuse (the thesis' clamped rule by default).
+    pub fusion_rule: FusionRule,
 }
 
 impl Default for GridConfig {
@@ -91,6 +111,7 @@ impl Default for GridConfig {
             selection: Selection::default(),
             seed: 7,
             split_on_unclamp: false,
+            fusion_rule: FusionRule::Clamped,
         }
     }
 }

@@ -52,6 +52,20 @@
 //! * Beams longer than [`GridConfig::max_range_m`] are cut and free only (OctoMap's rule).
 //! * Optional splitting of fused cells back into base cubes when an update would take them
 //!   out of the clamped state ([`GridConfig::split_on_unclamp`], the thesis' future work).
+//!   Splitting is exact and has no size limit: the changed base cubes are cut out and the
+//!   rest of the cuboid is covered by halving cuboids (`O(k log V)` pieces).
+//!
+//! # Extension beyond Khan 2017: equal-value fusion
+//!
+//! [`FusionRule::EqualValue`] fuses cells whose log-odds are bit-equal `f32`s, clamped or
+//! not — OctoMap's pruning rule (8 siblings with equal log-odds become their parent), but
+//! with cuboids grown in the thesis' search-direction order. The thesis' clamped rule fuses
+//! little when cells are seen a few times (a moving car at 0.2 m), while OctoMap prunes all
+//! the free space a single scan sees once. The map stays exact: a scan's updates inside a
+//! fused cell are collected; if they change every base cube to one value the cell is
+//! updated whole, otherwise it is split (changed cubes plus halving cuboids with the old
+//! value) before the updates apply, so every base cube carries the log-odds of an unfused
+//! lattice (property-tested).
 //!
 //! # Example
 //!
@@ -82,7 +96,7 @@ mod index;
 pub mod key;
 pub mod rtree;
 
-pub use config::{GridConfig, Selection, SensorModel};
+pub use config::{FusionRule, GridConfig, Selection, SensorModel};
 pub use grid::{Cuboid, GridError, GridStats, Occupancy, RtreeGrid, ScanUpdate};
 pub use key::KeyBox;
 pub use rtree::RTree;

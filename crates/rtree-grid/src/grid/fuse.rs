@@ -2,6 +2,7 @@
 //! checks of the spec's flagged rule (§2.F.4).
 
 use super::{RtreeGrid, SensorModel};
+use crate::config::FusionRule;
 use crate::key::KeyBox;
 
 /// One search direction: an axis and a sign.
@@ -59,10 +60,10 @@ impl RtreeGrid {
             if cell.log_odds.is_nan() {
                 return steps; // removed earlier in this pass
             }
-            let Some(occupied) = self.is_clamped(cell.log_odds) else {
+            if !self.may_fuse(cell.log_odds) {
                 return steps;
-            };
-            if !occupied && self.config.model == SensorModel::BeamEndPoint {
+            }
+            if self.config.model == SensorModel::BeamEndPoint && cell.log_odds <= self.l_threshold {
                 return steps; // §2.F.6: only occupied fusion
             }
             let mut fused = None;
@@ -70,7 +71,7 @@ impl RtreeGrid {
                 let Some(slab) = slab(&cell.bx, direction) else {
                     continue;
                 };
-                if self.slab_fuses(&slab, occupied, &mut members) {
+                if self.slab_fuses(&slab, cell.log_odds, &mut members) {
                     fused = Some(slab);
                     break;
                 }
@@ -79,32 +80,51 @@ impl RtreeGrid {
                 return steps;
             };
             // The fused cell's probability is the mean of its cells' (equal weight per
-            // cell, g_i included); all are clamped to the same bound.
-            let mut sum = f64::from(cell.log_odds);
-            for &m in &members {
-                sum += f64::from(self.log_odds[m as usize]);
-            }
-            let mean = (sum / (members.len() + 1) as f64) as f32;
+            // cell, g_i included); all are clamped to the same bound. Under the equal-value
+            // rule all are bit-equal and the value is kept as it is.
+            let value = match self.config.fusion_rule {
+                FusionRule::EqualValue => cell.log_odds,
+                FusionRule::Clamped => {
+                    let mut sum = f64::from(cell.log_odds);
+                    for &m in &members {
+                        sum += f64::from(self.log_odds[m as usize]);
+                    }
+                    (sum / (members.len() + 1) as f64) as f32
+                }
+            };
             self.delete_cell(id);
             for &m in &members {
                 self.delete_cell(m);
             }
-            id = self.create_cell(cell.bx.union(&slab), mean);
+            id = self.create_cell(cell.bx.union(&slab), value);
             steps += 1;
         }
     }
 
-    /// Whether the slab is exactly tiled by leaves lying completely inside it, all clamped
-    /// with polarity `occupied` (Eqs. 2.9–2.11 plus the coverage and containment checks);
-    /// fills `members` with them.
-    fn slab_fuses(&self, slab: &KeyBox, occupied: bool, members: &mut Vec<u32>) -> bool {
+    /// Whether log-odds `other` may fuse with a seed of log-odds `seed`: clamped at the same
+    /// bound (thesis), or bit-equal ([`FusionRule::EqualValue`]).
+    #[inline]
+    fn fuses_with(&self, seed: f32, other: f32) -> bool {
+        match self.config.fusion_rule {
+            FusionRule::EqualValue => seed.to_bits() == other.to_bits(),
+            FusionRule::Clamped => {
+                let c = self.is_clamped(seed);
+                c.is_some() && self.is_clamped(other) == c
+            }
+        }
+    }
+
+    /// Whether the slab is exactly tiled by leaves lying completely inside it, all fusing
+    /// with the seed's log-odds `seed` (Eqs. 2.9–2.11 plus the coverage and containment
+    /// checks); fills `members` with them.
+    fn slab_fuses(&self, slab: &KeyBox, seed: f32, members: &mut Vec<u32>) -> bool {
         members.clear();
         let mut volume = 0u64;
         let target = slab.volume();
         if target == 1 {
             // A single base cube: one index look-up.
             return match self.index.get(slab.lo, Self::key_of_cell(&self.tree)) {
-                Some(id) if self.is_clamped(self.log_odds[id as usize]) == Some(occupied) => {
+                Some(id) if self.fuses_with(seed, self.log_odds[id as usize]) => {
                     members.push(id);
                     true
                 }
@@ -125,7 +145,7 @@ impl RtreeGrid {
             let Some(id) = self.cell_id_of_key(key) else {
                 return false; // unknown space
             };
-            if self.is_clamped(self.log_odds[id as usize]) != Some(occupied)
+            if !self.fuses_with(seed, self.log_odds[id as usize])
                 || !self
                     .tree
                     .item_box(id)
@@ -135,9 +155,7 @@ impl RtreeGrid {
             }
         }
         let ok = self.tree.for_each_intersecting_while(slab, &mut |id, bx| {
-            if !slab.contains_box(bx)
-                || self.is_clamped(self.log_odds[id as usize]) != Some(occupied)
-            {
+            if !slab.contains_box(bx) || !self.fuses_with(seed, self.log_odds[id as usize]) {
                 return false;
             }
             volume += bx.volume();

@@ -3,13 +3,14 @@
 mod fuse;
 mod query;
 mod ray;
+mod split;
 #[cfg(test)]
 mod tests;
 
 use nalgebra::Point3;
 use raypath_geometry::{PointCloud, Pose3};
 
-use crate::config::{GridConfig, Selection, SensorModel, logit};
+use crate::config::{FusionRule, GridConfig, Selection, SensorModel, logit};
 use crate::coverage::FusedCoverage;
 use crate::index::LatticeIndex;
 use crate::key::{Key, KeyBox, key_of, pack, unpack};
@@ -93,6 +94,7 @@ pub struct RtreeGrid {
     free_keys: Vec<u64>,
     occupied_keys: Vec<u64>,
     touched_fused: Vec<(u32, bool)>,
+    touched_exact: Vec<(u32, u64, bool)>,
     selected: Vec<u32>,
     recent: ray::RecentKeys,
 }
@@ -152,6 +154,7 @@ impl RtreeGrid {
             free_keys: Vec::new(),
             occupied_keys: Vec::new(),
             touched_fused: Vec::new(),
+            touched_exact: Vec::new(),
             selected: Vec::new(),
             recent: ray::RecentKeys::new(),
         })
@@ -283,13 +286,14 @@ impl RtreeGrid {
                 let Some(id) = id else { continue };
                 let chosen = fusion
                     && (hit || sample_probability >= 1.0 || rng.next_f64() < sample_probability);
-                // Only clamped cells can fuse (checked again when fusing).
-                if chosen && self.is_clamped(self.log_odds[id as usize]).is_some() {
+                // Only cells that may fuse start fusions (checked again when fusing).
+                if chosen && self.may_fuse(self.log_odds[id as usize]) {
                     selected.push(id);
                 }
             }
         }
         self.apply_fused_updates();
+        self.apply_exact_updates(&mut selected, &mut update);
         if fusion {
             selected.sort_unstable();
             selected.dedup();
@@ -338,13 +342,12 @@ impl RtreeGrid {
             let found = cached.or_else(|| self.tree.find_containing(key));
             if let Some((id, bx)) = found {
                 self.last_fused = Some((id, bx));
-                let l = self.log_odds[id as usize];
-                let leaves_clamp = self.is_clamped(l).is_some()
-                    && self.is_clamped(self.updated(l, hit)) != self.is_clamped(l);
-                if self.config.split_on_unclamp && leaves_clamp && bx.volume() <= MAX_SPLIT {
-                    self.split_cell(id);
-                    update.splits += 1;
-                    return self.update_key(key, hit, update);
+                if self.exact_updates() {
+                    let l = self.log_odds[id as usize];
+                    if !self.keeps_value(l, self.updated(l, hit)) {
+                        self.touched_exact.push((id, pack(key), hit));
+                    }
+                    return Some(id);
                 }
                 self.touched_fused.push((id, hit));
                 return Some(id);
@@ -372,6 +375,33 @@ impl RtreeGrid {
         }
         touched.clear();
         self.touched_fused = touched;
+    }
+
+    /// Whether fused cells are kept exact (split when an update changes part of them).
+    #[inline]
+    fn exact_updates(&self) -> bool {
+        self.config.split_on_unclamp || self.config.fusion_rule == FusionRule::EqualValue
+    }
+
+    /// Whether an update from `old` to `new` leaves a fused cell's value as it is: bit-equal
+    /// under [`FusionRule::EqualValue`], clamped at the same bound under the thesis' rule.
+    #[inline]
+    fn keeps_value(&self, old: f32, new: f32) -> bool {
+        match self.config.fusion_rule {
+            FusionRule::EqualValue => old.to_bits() == new.to_bits(),
+            FusionRule::Clamped => {
+                self.is_clamped(old).is_some() && self.is_clamped(old) == self.is_clamped(new)
+            }
+        }
+    }
+
+    /// Whether a cell with this log-odds may start or join a fusion.
+    #[inline]
+    fn may_fuse(&self, log_odds: f32) -> bool {
+        match self.config.fusion_rule {
+            FusionRule::EqualValue => !log_odds.is_nan(),
+            FusionRule::Clamped => self.is_clamped(log_odds).is_some(),
+        }
     }
 
     /// `Some(true)` when clamped occupied, `Some(false)` when clamped free.
@@ -417,19 +447,6 @@ impl RtreeGrid {
         self.log_odds[id as usize] = f32::NAN;
         self.free_cells.push(id);
         cell
-    }
-
-    /// Replaces fused cell `id` by base cubes carrying its log-odds.
-    fn split_cell(&mut self, id: u32) {
-        let cell = self.delete_cell(id);
-        let (lo, hi) = (cell.bx.lo, cell.bx.hi);
-        for z in lo[2]..=hi[2] {
-            for y in lo[1]..=hi[1] {
-                for x in lo[0]..=hi[0] {
-                    self.create_cell(KeyBox::cube([x, y, z]), cell.log_odds);
-                }
-            }
-        }
     }
 
     /// Sizes of the map.
@@ -496,8 +513,6 @@ impl RtreeGrid {
         self.occupied_keys = Vec::new();
         self.selected = Vec::new();
         self.touched_fused = Vec::new();
+        self.touched_exact = Vec::new();
     }
 }
-
-/// Largest fused cell (in base cubes) that is split back when it leaves the clamped state.
-const MAX_SPLIT: u64 = 1 << 16;

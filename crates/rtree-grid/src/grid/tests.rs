@@ -251,3 +251,115 @@ fn compaction_keeps_the_map_and_frees_memory() {
     grid.insert_scan(&Point3::new(0.1, 0.2, 0.3), &scan);
     check(&grid);
 }
+
+/// Log-odds at every base cube the unfused `reference` knows, compared with `grid`; also
+/// checks `grid` knows no other cube (volume conservation). `tolerance` 0 means bit-equal.
+fn assert_matches_plain(grid: &RtreeGrid, reference: &RtreeGrid, tolerance: f32) {
+    assert_eq!(check(grid), reference.num_leaves() as u64);
+    reference.tree.for_each_item(&mut |id, bx| {
+        let expected = reference.log_odds[id as usize];
+        let (got_id, got_box) = grid
+            .cell_id_of_key(bx.lo)
+            .and_then(|g| grid.tree.item_box(g).map(|b| (g, b)))
+            .unwrap_or_else(|| panic!("cube {:?} missing", bx.lo));
+        assert!(got_box.contains_key(bx.lo));
+        let got = grid.log_odds[got_id as usize];
+        if tolerance == 0.0 {
+            assert_eq!(got.to_bits(), expected.to_bits(), "cube {:?}", bx.lo);
+        } else {
+            assert!((got - expected).abs() <= tolerance, "cube {:?}", bx.lo);
+        }
+    });
+}
+
+/// Scans from origins spread over the room, so later scans update parts of fused cells.
+fn moving_scans(seed: u64, scans: usize, points: usize) -> Vec<(Point3<f64>, Vec<Point3<f64>>)> {
+    (0..scans)
+        .map(|i| {
+            let mut rng = ray::SplitMix(seed ^ (i as u64 + 1).wrapping_mul(0xA24B_AED4_963E_E407));
+            let origin = Point3::new(
+                -2.0 + 4.0 * rng.next_f64(),
+                -1.5 + 3.0 * rng.next_f64(),
+                -0.5 + rng.next_f64(),
+            );
+            (origin, scan_points(seed.wrapping_add(i as u64), points))
+        })
+        .collect()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+
+    /// Split-on-update keeps the map exact: each base cube carries the log-odds of an
+    /// unfused lattice (bit-equal for the equal-value rule; within the clamping slack for
+    /// the thesis' rule with `split_on_unclamp`), leaves stay disjoint and cover exactly the
+    /// observed cubes, and the equal-value rule never fuses cells of different values.
+    #[test]
+    fn exact_fusion_matches_an_unfused_lattice(
+        seed in any::<u64>(),
+        m in prop::sample::select(vec![4usize, 8, 16]),
+        endpoint in any::<bool>(),
+        updated in any::<bool>(),
+        equal in any::<bool>(),
+        scans in 1usize..7,
+    ) {
+        let model = if endpoint { SensorModel::BeamEndPoint } else { SensorModel::BeamBased };
+        let mut config = GridConfig::with(0.25, m, model);
+        if updated {
+            config.selection = Selection::UpdatedCells;
+        }
+        if equal {
+            config.fusion_rule = FusionRule::EqualValue;
+        } else {
+            config.split_on_unclamp = true;
+        }
+        let data = moving_scans(seed, scans, 250);
+        let mut grid = RtreeGrid::new(config).unwrap();
+        let mut reference = RtreeGrid::new(GridConfig { fusion: false, ..config }).unwrap();
+        for (origin, points) in &data {
+            grid.insert_scan(origin, points);
+            reference.insert_scan(origin, points);
+            assert_matches_plain(&grid, &reference, if equal { 0.0 } else { 2.0 * CLAMP_EPS });
+        }
+        if equal && updated && !endpoint {
+            // Free cells seen once share one value: something fused.
+            prop_assert!(grid.stats().fused_leaves > 0);
+            prop_assert!(grid.num_leaves() < reference.num_leaves());
+        }
+    }
+}
+
+#[test]
+fn equal_value_fuses_unclamped_free_space_of_one_scan() {
+    let scan = scan_points(11, 3000);
+    for (rule, expect_fused) in [(FusionRule::Clamped, false), (FusionRule::EqualValue, true)] {
+        let mut config = GridConfig::with(0.2, 8, SensorModel::BeamBased);
+        config.fusion_rule = rule;
+        config.selection = Selection::UpdatedCells;
+        let mut grid = RtreeGrid::new(config).unwrap();
+        grid.insert_scan(&Point3::new(0.1, 0.2, 0.3), &scan);
+        let stats = grid.stats();
+        // One scan clamps nothing: only the equal-value rule fuses.
+        assert_eq!(stats.fused_leaves > 0, expect_fused, "{rule:?}");
+        let reference = plain(config, std::slice::from_ref(&scan));
+        assert_matches_plain(&grid, &reference, 0.0);
+    }
+    // A second scan from elsewhere changes parts of the fused free cuboids: they split and
+    // the map still equals the unfused lattice.
+    let mut config = GridConfig::with(0.2, 8, SensorModel::BeamBased);
+    config.fusion_rule = FusionRule::EqualValue;
+    let data = moving_scans(11, 2, 3000);
+    let mut grid = RtreeGrid::new(config).unwrap();
+    let mut reference = RtreeGrid::new(GridConfig {
+        fusion: false,
+        ..config
+    })
+    .unwrap();
+    let mut splits = 0;
+    for (origin, points) in &data {
+        splits += grid.insert_scan(origin, points).splits;
+        reference.insert_scan(origin, points);
+    }
+    assert!(splits > 0);
+    assert_matches_plain(&grid, &reference, 0.0);
+}
