@@ -10,6 +10,9 @@
 //!   ground truth and the integrated odometry (`odometry_mu_100hz.csv`) interpolated at the
 //!   scan times, in REP-103 frames (`NcltPose::world_from_body`; the body frame is the
 //!   velodyne frame in the simulated sessions — spec errata 24: no extrinsic applied).
+//! * **In memory** ([`Drive::from_fn`]): times and poses given by the caller, scans produced
+//!   on demand by a function (e.g. simulated, `raypath_sim::semi_kitti::SemiKittiDrive`), so
+//!   an evaluation streams a drive without writing its scans to disk.
 
 use std::path::{Path, PathBuf};
 
@@ -29,14 +32,21 @@ pub enum DriveFormat {
     Nclt,
 }
 
+/// The error a scan function of an in-memory drive may return.
+pub type ScanError = Box<dyn std::error::Error + Send + Sync>;
+
+/// A scan source of an in-memory drive: scan `index` → points in the sensor frame.
+pub type ScanFn = Box<dyn Fn(usize) -> std::result::Result<PointCloud, ScanError> + Send + Sync>;
+
 enum Source {
     Kitti { sequence: KittiSequence },
     Nclt { session: NcltSession },
+    Memory { scan: ScanFn },
 }
 
 /// A drive: per scan a time, a ground-truth sensor pose (when known) and an odometry pose.
 pub struct Drive {
-    /// The directory.
+    /// The directory (for an in-memory drive: its name), used in errors.
     pub dir: PathBuf,
     /// The layout.
     pub format: DriveFormat,
@@ -80,6 +90,49 @@ impl Drive {
             return Self::open_kitti(dir);
         }
         Self::open_nclt(dir)
+    }
+
+    /// A drive from parts held in memory: `name` (used in errors in place of a directory),
+    /// the layout its conventions follow (`format` selects the preset and the odometry
+    /// noise in the CLI), scan times (seconds, strictly increasing), the ground-truth
+    /// `world_from_sensor` per scan when known, the odometry `odom_from_sensor` per scan,
+    /// and `scan`, which returns scan `index` (points in the sensor frame, REP-103 axes,
+    /// metres) for `index < stamps_secs.len()`. Errors of `scan` become
+    /// [`PoleError::Sequence`] naming the drive and the scan index.
+    ///
+    /// Fails when the tracks do not have one pose per time or the times are not strictly
+    /// increasing.
+    pub fn from_fn(
+        name: &str,
+        format: DriveFormat,
+        stamps_secs: Vec<f64>,
+        ground_truth: Option<Vec<Pose3>>,
+        odometry: Vec<Pose3>,
+        scan: ScanFn,
+    ) -> Result<Self> {
+        let dir = PathBuf::from(name);
+        let mismatch = |what: &str, n: usize| PoleError::Sequence {
+            path: dir.clone(),
+            reason: format!("{n} {what} for {} scan times", stamps_secs.len()),
+        };
+        if odometry.len() != stamps_secs.len() {
+            return Err(mismatch("odometry poses", odometry.len()));
+        }
+        if let Some(gt) = &ground_truth
+            && gt.len() != stamps_secs.len()
+        {
+            return Err(mismatch("ground-truth poses", gt.len()));
+        }
+        check_increasing(&dir, &stamps_secs)?;
+        Ok(Self {
+            dir,
+            format,
+            stamps_secs,
+            ground_truth,
+            odometry,
+            odometry_std: None,
+            source: Source::Memory { scan },
+        })
     }
 
     fn open_kitti(dir: &Path) -> Result<Self> {
@@ -231,14 +284,31 @@ impl Drive {
                 nclt::flu_from_frd(&mut cloud);
                 Ok(cloud)
             }
+            Source::Memory { scan } => {
+                if index >= self.len() {
+                    return Err(out_of_range());
+                }
+                scan(index).map_err(|e| PoleError::Sequence {
+                    path: self.dir.clone(),
+                    reason: format!("scan {index}: {e}"),
+                })
+            }
         }
     }
 
-    /// Total number of points of all scans (from file sizes).
+    /// Total number of points of all scans (from file sizes; an in-memory drive produces
+    /// every scan to count them).
     pub fn count_points(&self) -> Result<u64> {
         Ok(match &self.source {
             Source::Kitti { sequence } => sequence.count_points()?,
             Source::Nclt { session } => session.count_points()?,
+            Source::Memory { .. } => {
+                let mut total = 0;
+                for i in 0..self.len() {
+                    total += self.scan(i)?.len() as u64;
+                }
+                total
+            }
         })
     }
 
@@ -264,4 +334,110 @@ fn check_increasing(dir: &Path, stamps: &[f64]) -> Result<()> {
         });
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Point3;
+
+    use super::*;
+
+    /// A drive of `n` scans 1 m apart; scan `i` holds `i + 1` points at x = i.
+    fn memory_drive(n: usize) -> Result<Drive> {
+        let poses: Vec<Pose3> = (0..n)
+            .map(|i| Pose3::from_xyz_rpy(i as f64, 0.0, 0.0, 0.0, 0.0, 0.0))
+            .collect();
+        Drive::from_fn(
+            "memory 00",
+            DriveFormat::Kitti,
+            (0..n).map(|i| i as f64 * 0.1).collect(),
+            Some(poses.clone()),
+            poses,
+            Box::new(|i| {
+                if i == 3 {
+                    return Err("simulated failure".into());
+                }
+                Ok(PointCloud::from_points(vec![
+                    Point3::new(i as f32, 0.0, 0.0);
+                    i + 1
+                ]))
+            }),
+        )
+    }
+
+    #[test]
+    fn in_memory_drive_streams_scans_and_names_itself_in_errors() {
+        let drive = memory_drive(5).unwrap();
+        assert_eq!(drive.len(), 5);
+        assert_eq!(drive.format, DriveFormat::Kitti);
+        assert_eq!(drive.require_ground_truth().unwrap().len(), 5);
+        let scan = drive.scan(2).unwrap();
+        assert_eq!(scan.len(), 3);
+        assert_eq!(scan.points[0].x, 2.0);
+        let failed = drive.scan(3).unwrap_err().to_string();
+        assert!(
+            failed.contains("memory 00")
+                && failed.contains("scan 3")
+                && failed.contains("simulated failure"),
+            "{failed}"
+        );
+        let past = drive.scan(5).unwrap_err().to_string();
+        assert!(
+            past.contains("memory 00") && past.contains("no scan 5"),
+            "{past}"
+        );
+        // Counting produces every scan: the failing one is reported.
+        assert!(drive.count_points().is_err());
+        let ok = memory_drive(3).unwrap();
+        assert_eq!(ok.count_points().unwrap(), 1 + 2 + 3);
+    }
+
+    #[test]
+    fn in_memory_drive_checks_its_parts() {
+        let pose = Pose3::identity();
+        let scans = || -> ScanFn { Box::new(|_| Ok(PointCloud::from_points(Vec::new()))) };
+        let short_odometry = Drive::from_fn(
+            "d",
+            DriveFormat::Nclt,
+            vec![0.0, 1.0],
+            None,
+            vec![pose],
+            scans(),
+        );
+        assert!(short_odometry.is_err());
+        let short_truth = Drive::from_fn(
+            "d",
+            DriveFormat::Nclt,
+            vec![0.0, 1.0],
+            Some(vec![pose; 3]),
+            vec![pose; 2],
+            scans(),
+        );
+        assert!(short_truth.is_err());
+        let not_increasing = Drive::from_fn(
+            "d",
+            DriveFormat::Nclt,
+            vec![1.0, 1.0],
+            None,
+            vec![pose; 2],
+            scans(),
+        )
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+        assert!(
+            not_increasing.contains("not strictly increasing"),
+            "{not_increasing}"
+        );
+        let drive = Drive::from_fn(
+            "d",
+            DriveFormat::Nclt,
+            vec![0.0, 1.0],
+            None,
+            vec![pose; 2],
+            scans(),
+        )
+        .unwrap();
+        assert!(drive.require_ground_truth().is_err());
+    }
 }

@@ -111,7 +111,7 @@ mod score;
 mod tracer;
 
 pub use beta::ReflectionPrior;
-pub use drive::{Drive, DriveFormat};
+pub use drive::{Drive, DriveFormat, ScanError, ScanFn};
 pub use error::{PoleError, Result};
 pub use extract::{
     ExtractionStats, extract_poles, local_grid, non_maximum_suppression, occupancy,

@@ -21,16 +21,19 @@ use std::time::Instant;
 
 use nalgebra::{Point2, Point3};
 use rand::Rng;
-use raypath_geometry::Pose3;
+use raypath_geometry::{PointCloud, Pose3};
 use raypath_io::kitti::{self, KittiLayout};
 use raypath_io::point_csv::PointCsv;
 
 use crate::error::{Result, SimError};
-use crate::lidar3::Lidar3;
+use crate::lidar3::{Lidar3, SimScan};
 use crate::rng;
+use crate::scene3::Scene3;
 use crate::urban::along_path::{PathSample, Scenery, world_along_path};
-use crate::urban::kitti_out::{KittiSequenceFiles, kitti_cam0_from_velo, write_sequence};
+use crate::urban::kinds::Pole;
+use crate::urban::kitti_out::{KittiSequenceFiles, kitti_cam0_from_velo, write_sequence_with};
 use crate::urban::output::{list_files, pole_counts_json, write_poles_csv};
+use crate::urban::world::World;
 use crate::{GeneratedSet, Progress};
 
 const DOMAIN_LIDAR: u64 = 0x5345_4d49_4c49_4441;
@@ -132,25 +135,128 @@ impl SemiKittiConfig {
     }
 }
 
-/// Builds the world around the drive, scans the selected frames and writes the KITTI layout
-/// under `out_dir`. Deterministic by seed.
-pub fn generate_semi_kitti(
-    config: &SemiKittiConfig,
-    seed: u64,
-    out_dir: &Path,
-    progress: Progress,
-) -> Result<GeneratedSet> {
-    config.validate()?;
-    let started = Instant::now();
-    let cam0_from_velo = kitti_cam0_from_velo();
-    let world_from_velo = kitti::velodyne_poses_from_cam0(&config.poses, &cam0_from_velo);
-    let frames = config.frames();
-    let last = frames.last().copied().unwrap_or(0);
-    // Trajectory samples every 2 m over the frames driven.
-    let height = config.scenery.sensor_height_m;
+/// A semi-synthetic drive held in memory: the world built around the real trajectory, the
+/// lidar, and per scan the velodyne pose and time; [`SemiKittiDrive::scan`] simulates one
+/// scan on demand. Scan `i` is the `i`-th of [`SemiKittiConfig::frames`] and equals the
+/// scan [`generate_semi_kitti`] writes as frame `i` (both go through
+/// [`SemiKittiDrive::sim_scan`]), so an evaluation can stream a drive without writing
+/// 2.6 GB of scans per sequence.
+///
+/// Frames: `world_from_velo` is in the world frame of the pole map (the velodyne frame of
+/// input frame 0; REP-103 axes, metres), which is also the frame the scene is built in.
+pub struct SemiKittiDrive {
+    /// Sequence name.
+    pub sequence: String,
+    /// The input frame of each scan.
+    pub frames: Vec<usize>,
+    /// `world_from_velo` of each scan.
+    pub world_from_velo: Vec<Pose3>,
+    /// Time of each scan, seconds (the real times).
+    pub times_s: Vec<f64>,
+    /// The poles placed in the scene (`id` = row of the input map), in the world frame.
+    pub poles: Vec<Pole>,
+    /// Rows of the input pole map left out because the trajectory passes within 1 m.
+    pub poles_left_out: Vec<usize>,
+    /// Length of the trajectory driven (samples every 2 m), metres.
+    pub trajectory_length_m: f64,
+    world: World,
+    scene: Scene3,
+    lidar: Lidar3,
+    scan_seed: u64,
+}
+
+impl SemiKittiDrive {
+    /// Builds the world around the frames of `config` driven (deterministic by `seed`).
+    pub fn new(config: &SemiKittiConfig, seed: u64) -> Result<Self> {
+        config.validate()?;
+        let cam0_from_velo = kitti_cam0_from_velo();
+        let world_from_velo = kitti::velodyne_poses_from_cam0(&config.poses, &cam0_from_velo);
+        let frames = config.frames();
+        let last = frames.last().copied().unwrap_or(0);
+        let (samples, length_m) =
+            path_samples(&world_from_velo[..=last], config.scenery.sensor_height_m)?;
+        let (world, report) = world_along_path(&samples, &config.poles, &config.scenery, seed);
+        let scene = world.build_scene()?;
+        let lidar = Lidar3::hdl64e().with_firings(config.firings)?;
+        Ok(Self {
+            sequence: config.sequence.clone(),
+            world_from_velo: frames.iter().map(|&i| world_from_velo[i]).collect(),
+            times_s: frames.iter().map(|&i| config.times[i]).collect(),
+            frames,
+            poles: world.pole_list(),
+            poles_left_out: report.poles_on_trajectory,
+            trajectory_length_m: length_m,
+            world,
+            scene,
+            lidar,
+            scan_seed: rng::stream(seed, DOMAIN_LIDAR, 0).random(),
+        })
+    }
+
+    /// Number of scans.
+    pub fn len(&self) -> usize {
+        self.world_from_velo.len()
+    }
+
+    /// True when there are no scans.
+    pub fn is_empty(&self) -> bool {
+        self.world_from_velo.is_empty()
+    }
+
+    /// The simulated lidar.
+    pub fn lidar(&self) -> &Lidar3 {
+        &self.lidar
+    }
+
+    /// The world built around the drive.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// Simulates scan `index` in full (organized, with no-returns, labels and surfaces).
+    pub fn sim_scan(&self, index: usize) -> Result<SimScan> {
+        let pose = self
+            .world_from_velo
+            .get(index)
+            .ok_or_else(|| SimError::InvalidParameter {
+                name: "scan",
+                reason: format!("no scan {index} (the drive has {})", self.len()),
+            })?;
+        self.lidar
+            .scan(&self.scene, pose, self.scan_seed, index as u64)
+    }
+
+    /// Simulates scan `index` as written to `velodyne/NNNNNN.bin` (and `labels/`): the
+    /// returns only (no-returns dropped), in the velodyne frame (REP-103, metres), with
+    /// intensity and SemanticKITTI label, in the order of the organized scan.
+    pub fn scan(&self, index: usize) -> Result<PointCloud> {
+        Ok(returns_only(&self.sim_scan(index)?.cloud))
+    }
+}
+
+/// The returns of an organized cloud (finite points), keeping intensity and label.
+fn returns_only(cloud: &PointCloud) -> PointCloud {
+    let keep: Vec<usize> = (0..cloud.len())
+        .filter(|&i| cloud.points[i].iter().all(|v| v.is_finite()))
+        .collect();
+    let mut out = PointCloud::from_points(keep.iter().map(|&i| cloud.points[i]).collect());
+    out.intensity = pick(&keep, &cloud.intensity);
+    out.label = pick(&keep, &cloud.label);
+    out
+}
+
+/// The entries `keep` of an optional per-point channel.
+fn pick<T: Copy>(keep: &[usize], values: &Option<Vec<T>>) -> Option<Vec<T>> {
+    values
+        .as_ref()
+        .map(|v| keep.iter().filter_map(|&i| v.get(i).copied()).collect())
+}
+
+/// Trajectory samples every 2 m (with the ground below the sensor) and the length driven.
+fn path_samples(world_from_velo: &[Pose3], height: f64) -> Result<(Vec<PathSample>, f64)> {
     let mut samples: Vec<PathSample> = Vec::new();
     let mut length_m = 0.0;
-    for pose in world_from_velo.iter().take(last + 1) {
+    for pose in world_from_velo {
         let planar = pose.to_planar();
         let position = Point2::new(planar.x(), planar.y());
         let ground = pose.transform_point(&Point3::new(0.0, 0.0, -height));
@@ -185,46 +291,52 @@ pub fn generate_semi_kitti(
             ..first
         });
     }
-    let (world, report) = world_along_path(&samples, &config.poles, &config.scenery, seed);
-    let scene = world.build_scene()?;
-    let scene_from_velo: Vec<Pose3> = frames.iter().map(|&i| world_from_velo[i]).collect();
-    let times: Vec<f64> = frames.iter().map(|&i| config.times[i]).collect();
+    Ok((samples, length_m))
+}
+
+/// Builds the world around the drive, scans the selected frames and writes the KITTI layout
+/// under `out_dir`. Deterministic by seed; the scans are those of [`SemiKittiDrive::scan`].
+pub fn generate_semi_kitti(
+    config: &SemiKittiConfig,
+    seed: u64,
+    out_dir: &Path,
+    progress: Progress,
+) -> Result<GeneratedSet> {
+    let started = Instant::now();
+    let drive = SemiKittiDrive::new(config, seed)?;
     let layout = KittiLayout::new(out_dir, config.sequence.clone());
-    let lidar = Lidar3::hdl64e().with_firings(config.firings)?;
-    let scan_stats = write_sequence(
+    let scan_stats = write_sequence_with(
         &KittiSequenceFiles {
             layout: &layout,
-            world_from_velo: &scene_from_velo,
-            times_s: &times,
+            world_from_velo: &drive.world_from_velo,
+            times_s: &drive.times_s,
             labels: config.labels,
         },
-        &scene,
-        &lidar,
-        &scene_from_velo,
-        rng::stream(seed, DOMAIN_LIDAR, 0).random(),
+        &|i| drive.sim_scan(i),
         progress,
     )?;
-    let poles = world.pole_list();
     write_poles_csv(
         &layout.sequence_dir().join("poles.csv"),
-        &poles,
+        &drive.poles,
         &Pose3::identity(),
     )?;
     let elapsed = started.elapsed().as_secs_f64();
+    let times = &drive.times_s;
+    let world = drive.world();
     let stats = serde_json::json!({
         "sequence": config.sequence,
         "frames_in_input": config.poses.len(),
         "stride": config.stride,
-        "lidar": lidar.name,
-        "rays_per_scan": lidar.num_rays(),
+        "lidar": drive.lidar.name,
+        "rays_per_scan": drive.lidar.num_rays(),
         "scans": scan_stats.to_json(),
-        "trajectory_length_m": length_m,
+        "trajectory_length_m": drive.trajectory_length_m,
         "duration_s": times.last().copied().unwrap_or(0.0) - times.first().copied().unwrap_or(0.0),
         "poles_in_input": config.poles.len(),
-        "poles_placed": pole_counts_json(&poles),
-        "poles_left_out_on_trajectory": report.poles_on_trajectory.len(),
+        "poles_placed": pole_counts_json(&drive.poles),
+        "poles_left_out_on_trajectory": drive.poles_left_out.len(),
         "world": {
-            "triangles": scene.num_triangles(),
+            "triangles": drive.scene.num_triangles(),
             "buildings": world.buildings.len(),
             "parked_cars": world.cars.len(),
             "sidewalk_pieces": world.slabs.len(),

@@ -13,7 +13,9 @@ use raypath_io::data::require;
 use raypath_io::kitti::{self, KittiSequence};
 use raypath_io::point_csv::PointCsv;
 use raypath_sim::no_progress;
-use raypath_sim::semi_kitti::{SemiKittiConfig, SemiKittiSetConfig, generate, generate_semi_kitti};
+use raypath_sim::semi_kitti::{
+    SemiKittiConfig, SemiKittiDrive, SemiKittiSetConfig, generate, generate_semi_kitti,
+};
 use raypath_sim::urban::kinds::label;
 use raypath_sim::urban::kitti_out::kitti_cam0_from_velo;
 
@@ -142,6 +144,51 @@ fn semi_kitti_output_is_deterministic_and_checks_its_input() {
     let mut bad = config;
     bad.stride = 0;
     assert!(generate_semi_kitti(&bad, 4, a.path(), no_progress()).is_err());
+}
+
+#[test]
+fn streamed_scans_equal_the_written_ones() {
+    let mut config = l_drive();
+    config.firings = 360;
+    config.max_scans = Some(4);
+    let dir = tempfile::tempdir().unwrap();
+    generate_semi_kitti(&config, 5, dir.path(), no_progress()).unwrap();
+    let drive = SemiKittiDrive::new(&config, 5).unwrap();
+    assert_eq!(drive.len(), 4);
+    assert_eq!(drive.frames, config.frames());
+    let seq_dir = dir.path().join("sequences/09");
+    // Poses and times: the written camera poses map back to the drive's velodyne poses.
+    let sequence = KittiSequence::open(&seq_dir).unwrap();
+    let velo = kitti::velodyne_poses_from_cam0(&sequence.poses().unwrap(), &kitti_cam0_from_velo());
+    for (read, streamed) in velo.iter().zip(&drive.world_from_velo) {
+        assert!((read.translation() - streamed.translation()).norm() < 1e-5);
+    }
+    assert_eq!(sequence.times().unwrap().len(), drive.times_s.len());
+    // The placed poles are the written ones.
+    let written = PointCsv::read(&seq_dir.join("poles.csv")).unwrap();
+    assert_eq!(written.len(), drive.poles.len());
+    for (row, pole) in written.rows().zip(&drive.poles) {
+        assert!((row[0] - pole.x).abs() < 1e-4 && (row[1] - pole.y).abs() < 1e-4);
+        assert_eq!(row[5] as u32, pole.id);
+    }
+    assert_eq!(drive.poles_left_out, vec![0]);
+    // Scans in reverse order (no hidden state): bit-equal points, intensities and labels.
+    for frame in (0..4).rev() {
+        let streamed = drive.scan(frame).unwrap();
+        let file = kitti::read_velodyne(&seq_dir.join(format!("velodyne/{frame:06}.bin"))).unwrap();
+        assert!(streamed.len() > 1000, "{} points", streamed.len());
+        assert_eq!(streamed.points, file.points);
+        assert_eq!(streamed.intensity, file.intensity);
+        let labels: Vec<u32> = std::fs::read(seq_dir.join(format!("labels/{frame:06}.label")))
+            .unwrap()
+            .chunks_exact(4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        assert_eq!(streamed.label.as_deref(), Some(labels.as_slice()));
+    }
+    // Different scans differ; a scan past the end is an error, not a panic.
+    assert_ne!(drive.scan(0).unwrap().points, drive.scan(1).unwrap().points);
+    assert!(drive.scan(4).is_err());
 }
 
 #[test]

@@ -25,7 +25,7 @@ use raypath_io::kitti::{self, KittiCalib, KittiLayout};
 
 use super::output::{ScanStats, create_dir, encode_labels, remove_stale, write_bytes};
 use crate::error::Result;
-use crate::lidar3::Lidar3;
+use crate::lidar3::{Lidar3, SimScan};
 use crate::scene3::Scene3;
 use crate::{Progress, SimError};
 
@@ -95,10 +95,34 @@ pub(crate) fn write_sequence(
     seed: u64,
     progress: Progress,
 ) -> Result<ScanStats> {
+    if scene_from_velo.len() != files.world_from_velo.len() {
+        return Err(SimError::InvalidParameter {
+            name: "poses",
+            reason: "one scene pose, world pose and time per scan".into(),
+        });
+    }
+    let scan = |i: usize| -> Result<SimScan> {
+        let pose = scene_from_velo
+            .get(i)
+            .ok_or_else(|| SimError::InvalidParameter {
+                name: "scan",
+                reason: format!("no scan {i}"),
+            })?;
+        lidar.scan(scene, pose, seed, i as u64)
+    };
+    write_sequence_with(files, &scan, progress)
+}
+
+/// Writes the poses, times and calibration, then simulates scan `i` with `scan(i)` for every
+/// `i` of `files.world_from_velo` in parallel and writes it. Stale scans of an earlier run
+/// into the same directory are deleted first.
+pub(crate) fn write_sequence_with(
+    files: &KittiSequenceFiles<'_>,
+    scan: &(dyn Fn(usize) -> Result<SimScan> + Sync),
+    progress: Progress,
+) -> Result<ScanStats> {
     let layout = files.layout;
-    if scene_from_velo.len() != files.world_from_velo.len()
-        || files.times_s.len() != scene_from_velo.len()
-    {
+    if files.times_s.len() != files.world_from_velo.len() {
         return Err(SimError::InvalidParameter {
             name: "poses",
             reason: "one scene pose, world pose and time per scan".into(),
@@ -118,14 +142,13 @@ pub(crate) fn write_sequence(
     let camera_poses = kitti::cam0_poses_from_velodyne(files.world_from_velo, &cam0_from_velo);
     kitti::write_poses(&layout.poses_path(), &camera_poses)?;
 
-    let total = scene_from_velo.len() as u64;
+    let total = files.world_from_velo.len() as u64;
     let done = AtomicU64::new(0);
     progress(0, total);
-    let stats = scene_from_velo
-        .par_iter()
-        .enumerate()
-        .map(|(i, pose)| -> Result<ScanStats> {
-            let scan = lidar.scan(scene, pose, seed, i as u64)?;
+    let stats = (0..files.world_from_velo.len())
+        .into_par_iter()
+        .map(|i| -> Result<ScanStats> {
+            let scan = scan(i)?;
             let frame = i as u64;
             kitti::write_velodyne(&layout.scan_path(frame), &scan.cloud)?;
             if files.labels {
