@@ -360,6 +360,11 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         row.push(fmt_num(total_secs, 0));
         speed.row(row);
         entry["total_secs"] = json!(total_secs);
+        // One line per sequence on stderr: progress of long runs in a log.
+        eprintln!(
+            "poles-kitti: sequence {} done in {total_secs:.0} s: {entry}",
+            plan.sequence
+        );
         results.push(entry);
     }
     if summaries.len() > 1 {
