@@ -255,6 +255,12 @@ fn evaluate(
         .flat_map(|m| m.poles.iter().copied())
         .collect();
     let map = merge_poles(&all, preset.segments.min_map_detections);
+    eprintln!(
+        "  map: {} poles from {} local maps (f_map {:?})",
+        map.len(),
+        contributing.len(),
+        f_map
+    );
 
     // 2. Localization of every session.
     let mut table = Table::new([
@@ -368,6 +374,14 @@ fn evaluate(
             fmt_num(quality.mean_centre_error_m, 3),
         ]);
         speed.row(speed_row(date, &totals, &run_results, 50.0));
+        eprintln!(
+            "  {date}: {end} scans, Δ_pos {:.3} m, RMSE {:.3} m, {} / {} diverged ({:.0} s)",
+            s.mean_pos,
+            s.rmse_pos,
+            s.diverged,
+            s.runs,
+            opened.elapsed().as_secs_f64()
+        );
         results.push(json!({
             "session": date,
             "scans": end,
@@ -507,6 +521,15 @@ fn report(
     )?;
     writeln!(
         md,
+        "## Semi-NCLT: sessions\n\nChanges with respect to the previous session (poles \
+         removed / moved / added, cumulative: a removed pole stays removed), parked cars, \
+         construction zones with barrels, leaf factor of the crowns. The quarter-window shift of \
+         the session plan makes the reference map cover the first session's window and the \
+         new quarters of the later ones.\n\n{}",
+        sessions_table(campus).to_markdown()
+    )?;
+    writeln!(
+        md,
         "## Semi-NCLT: localization beside Table 12.1\n\n{}",
         semi.localization.to_markdown()
     )?;
@@ -563,6 +586,44 @@ fn report(
         total_secs,
     )?;
     Ok(md)
+}
+
+/// The sessions of the campus and their changes.
+fn sessions_table(campus: &SemiNclt) -> Table {
+    let mut table = Table::new([
+        "session",
+        "window [m]",
+        "poles in world",
+        "removed",
+        "moved",
+        "added",
+        "parked cars",
+        "zones with barrels",
+        "foliage",
+    ]);
+    let c = campus.config();
+    for k in 0..campus.len() {
+        let Some((world, log)) = campus.world(k) else {
+            continue;
+        };
+        let (a, b) = c.window_m(k, campus.path().length_m());
+        table.row([
+            c.sessions.get(k).cloned().unwrap_or_default(),
+            format!("{a:.0}–{b:.0}"),
+            world.poles.len().to_string(),
+            log.removed.len().to_string(),
+            log.moved.len().to_string(),
+            log.added.len().to_string(),
+            log.parked_cars.to_string(),
+            format!(
+                "{} / {}",
+                log.barrel_shifts_m.iter().filter(|z| z.is_some()).count(),
+                log.barrel_shifts_m.len()
+            ),
+            fmt_num(log.foliage, 2),
+        ]);
+    }
+    table
 }
 
 fn add_totals(total: &mut ExtractionTotals, t: &ExtractionTotals) {
