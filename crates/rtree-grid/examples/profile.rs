@@ -2,12 +2,12 @@
 #![allow(missing_docs, clippy::unwrap_used)]
 use std::time::Instant;
 
-use raypath_rtree_grid::{GridConfig, RtreeGrid, SensorModel};
+use raypath_rtree_grid::{FusionRule, GridConfig, RtreeGrid, Selection, SensorModel};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let Some(path) = args.get(1) else {
-        eprintln!("usage: profile <scans.graph> [resolution_m]");
+        eprintln!("usage: profile <scans.graph> [resolution_m] [label filter]");
         std::process::exit(2);
     };
     let graph = match raypath_io::octomap::read_graph(std::path::Path::new(path)) {
@@ -18,26 +18,76 @@ fn main() {
         }
     };
     let r: f64 = args.get(2).map_or(0.2, |s| s.parse().unwrap());
-    for (label, fusion, model) in [
-        ("beam, fusion", true, SensorModel::BeamBased),
-        ("beam, no fusion", false, SensorModel::BeamBased),
-        ("endpoint, fusion", true, SensorModel::BeamEndPoint),
+    let only: Option<&str> = args.get(3).map(String::as_str);
+    let max_scans: usize = args.get(4).map_or(usize::MAX, |s| s.parse().unwrap());
+    for (label, fusion, model, rule, selection) in [
+        (
+            "beam, clamped",
+            true,
+            SensorModel::BeamBased,
+            FusionRule::Clamped,
+            None,
+        ),
+        (
+            "beam, no fusion",
+            false,
+            SensorModel::BeamBased,
+            FusionRule::Clamped,
+            None,
+        ),
+        (
+            "beam, equal",
+            true,
+            SensorModel::BeamBased,
+            FusionRule::EqualValue,
+            None,
+        ),
+        (
+            "beam, equal, updated",
+            true,
+            SensorModel::BeamBased,
+            FusionRule::EqualValue,
+            Some(Selection::UpdatedCells),
+        ),
+        (
+            "endpoint, clamped",
+            true,
+            SensorModel::BeamEndPoint,
+            FusionRule::Clamped,
+            None,
+        ),
+        (
+            "endpoint, equal",
+            true,
+            SensorModel::BeamEndPoint,
+            FusionRule::EqualValue,
+            None,
+        ),
     ] {
+        if only.is_some_and(|o| !label.contains(o)) {
+            continue;
+        }
         let mut config = GridConfig::with(r, 8, model);
         config.fusion = fusion;
+        config.fusion_rule = rule;
+        if let Some(selection) = selection {
+            config.selection = selection;
+        }
         let mut grid = RtreeGrid::new(config).unwrap();
         let t = Instant::now();
         let mut keys = 0;
-        for n in &graph.nodes {
+        let mut splits = 0;
+        for n in graph.nodes.iter().take(max_scans) {
             let u = grid.insert_cloud(&n.world_from_sensor, &n.points);
             keys += u.free_keys + u.occupied_keys;
+            splits += u.splits;
         }
+        let secs = t.elapsed().as_secs_f64();
+        grid.shrink_to_fit();
         let s = grid.stats();
         println!(
-            "{label}: {:.3} s, {keys} key updates, {} leaves, {} fused",
-            t.elapsed().as_secs_f64(),
-            s.leaves,
-            s.fused_leaves
+            "{label}: {secs:.3} s, {keys} key updates, {} leaves, {} fused, {splits} splits, {} bytes",
+            s.leaves, s.fused_leaves, s.bytes
         );
     }
 }

@@ -131,9 +131,17 @@ impl RtreeGrid {
                 _ => false,
             };
         }
-        // Necessary conditions on the slab's 8 corner cubes, checked with point look-ups
-        // (hash probe, or a point query near fused cells) before the slab query: each must
-        // lie in a known cell that is clamped with the right polarity and inside the slab.
+        if target <= SMALL_SLAB {
+            match self.small_slab_fuses(slab, seed, members) {
+                Some(answer) => return answer,
+                None => members.clear(),
+            }
+        }
+        // Necessary conditions on the slab's 8 corner cubes, checked with cheap look-ups
+        // (hash probe; near fused cells the last-found cell and the block cache) before the
+        // slab query: each must lie in a known cell of a fusing value inside the slab.
+        // Corners the caches cannot place are left to the slab query (a negative R-tree
+        // point query costs as much as the slab query).
         for corner in 0..8u8 {
             let key = [0, 1, 2].map(|a| {
                 if corner & (1 << a) != 0 {
@@ -142,8 +150,13 @@ impl RtreeGrid {
                     slab.lo[a]
                 }
             });
-            let Some(id) = self.cell_id_of_key(key) else {
-                return false; // unknown space
+            let id = match self.index.get(key, Self::key_of_cell(&self.tree)) {
+                Some(id) => id,
+                None if !self.coverage.may_contain(key) => return false, // unknown space
+                None => match self.fused_hint(key) {
+                    Some(id) => id,
+                    None => continue,
+                },
             };
             if !self.fuses_with(seed, self.log_odds[id as usize])
                 || !self
@@ -153,6 +166,11 @@ impl RtreeGrid {
             {
                 return false;
             }
+        }
+        // Larger slabs: up to 4 × 4 × 4 more probes spread over the slab catch unknown gaps
+        // and other values before the tree query.
+        if !self.probes_pass(slab, seed) {
+            return false;
         }
         let ok = self.tree.for_each_intersecting_while(slab, &mut |id, bx| {
             if !slab.contains_box(bx) || !self.fuses_with(seed, self.log_odds[id as usize]) {
@@ -165,6 +183,85 @@ impl RtreeGrid {
         ok && volume == target
     }
 }
+
+impl RtreeGrid {
+    /// [`Self::slab_fuses`] for a small slab by looking up each of its base cubes (hash
+    /// probes; fused cells through the caches), stopping at the first cube that fails;
+    /// `None` when a cube needs a tree search.
+    fn small_slab_fuses(&self, slab: &KeyBox, seed: f32, members: &mut Vec<u32>) -> Option<bool> {
+        for z in slab.lo[2]..=slab.hi[2] {
+            for y in slab.lo[1]..=slab.hi[1] {
+                for x in slab.lo[0]..=slab.hi[0] {
+                    let key = [x, y, z];
+                    let id = match self.index.get(key, Self::key_of_cell(&self.tree)) {
+                        Some(id) => id,
+                        None if !self.coverage.may_contain(key) => return Some(false),
+                        None => {
+                            let id = self.fused_hint(key)?;
+                            let Some(bx) = self.tree.item_box(id) else {
+                                return Some(false);
+                            };
+                            if !slab.contains_box(&bx) {
+                                return Some(false);
+                            }
+                            if bx.lo != key {
+                                continue; // counted at its first cube (z, y, x order)
+                            }
+                            id
+                        }
+                    };
+                    if !self.fuses_with(seed, self.log_odds[id as usize]) {
+                        return Some(false);
+                    }
+                    members.push(id);
+                }
+            }
+        }
+        Some(true)
+    }
+}
+
+impl RtreeGrid {
+    /// Probes a lattice of up to 4 per axis spread over `slab`: `false` when a probe lies
+    /// in unknown space or in a cell that cannot join the fusion (probes the caches cannot
+    /// place pass).
+    fn probes_pass(&self, slab: &KeyBox, seed: f32) -> bool {
+        let steps = slab.widths().map(|w| (w / 4).max(1));
+        let w = slab.widths();
+        for iz in 0..w[2].min(4) {
+            for iy in 0..w[1].min(4) {
+                for ix in 0..w[0].min(4) {
+                    let off = [ix, iy, iz];
+                    let key: [u16; 3] = [0, 1, 2].map(|a| {
+                        let k = u32::from(slab.lo[a]) + off[a] * steps[a] + steps[a] / 2;
+                        k.min(u32::from(slab.hi[a])) as u16
+                    });
+                    let id = match self.index.get(key, Self::key_of_cell(&self.tree)) {
+                        Some(id) => id,
+                        None if !self.coverage.may_contain(key) => return false,
+                        None => match self.fused_hint(key) {
+                            Some(id) => id,
+                            None => continue,
+                        },
+                    };
+                    if !self.fuses_with(seed, self.log_odds[id as usize])
+                        || !self
+                            .tree
+                            .item_box(id)
+                            .is_some_and(|b| slab.contains_box(&b))
+                    {
+                        return false;
+                    }
+                }
+            }
+        }
+        true
+    }
+}
+
+/// Slabs of at most this many base cubes are checked cube by cube instead of by a tree
+/// query.
+const SMALL_SLAB: u64 = 64;
 
 #[cfg(test)]
 mod tests {

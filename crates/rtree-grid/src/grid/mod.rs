@@ -1,5 +1,6 @@
 //! The Rtree variable-resolution occupancy grid (Khan 2017, §2.5).
 
+mod cache;
 mod fuse;
 mod query;
 mod ray;
@@ -97,6 +98,7 @@ pub struct RtreeGrid {
     touched_exact: Vec<(u32, u64, bool)>,
     selected: Vec<u32>,
     recent: ray::RecentKeys,
+    fused_cache: cache::FusedCache,
 }
 
 /// Slack when comparing a log-odds with a clamping bound.
@@ -157,6 +159,7 @@ impl RtreeGrid {
             touched_exact: Vec::new(),
             selected: Vec::new(),
             recent: ray::RecentKeys::new(),
+            fused_cache: cache::FusedCache::new(),
         })
     }
 
@@ -322,6 +325,36 @@ impl RtreeGrid {
         self.tree.find_containing(key).map(|(id, _)| id)
     }
 
+    /// The live fused cell containing `key` if the last-found cell or the block cache
+    /// knows it (no tree search).
+    #[inline]
+    fn fused_hint(&self, key: Key) -> Option<u32> {
+        if let Some((id, _)) = self.last_fused.filter(|&(_, bx)| bx.contains_key(key)) {
+            return Some(id);
+        }
+        let id = self.fused_cache.get(key)?;
+        let bx = self.tree.item_box(id)?;
+        let l = self.log_odds.get(id as usize)?;
+        (!l.is_nan() && bx.volume() > 1 && bx.contains_key(key)).then_some(id)
+    }
+
+    /// The fused cell containing `key` (not in the lattice index): the last one found, the
+    /// block cache, then an R-tree point query.
+    fn find_fused(&mut self, key: Key) -> Option<(u32, KeyBox)> {
+        if let Some(found) = self.last_fused.filter(|&(_, bx)| bx.contains_key(key)) {
+            return Some(found);
+        }
+        if let Some(id) = self.fused_hint(key) {
+            let found = (id, self.tree.item_box(id).unwrap_or(KeyBox::cube(key)));
+            self.last_fused = Some(found);
+            return Some(found);
+        }
+        let found = self.tree.find_containing(key)?;
+        self.fused_cache.put(key, found.0);
+        self.last_fused = Some(found);
+        Some(found)
+    }
+
     #[inline]
     fn updated(&self, log_odds: f32, hit: bool) -> f32 {
         let delta = if hit { self.l_hit } else { self.l_miss };
@@ -338,10 +371,7 @@ impl RtreeGrid {
         }
         if self.coverage.may_contain(key) {
             // Sorted keys run along x: the previous fused cell often holds the next key too.
-            let cached = self.last_fused.filter(|&(_, bx)| bx.contains_key(key));
-            let found = cached.or_else(|| self.tree.find_containing(key));
-            if let Some((id, bx)) = found {
-                self.last_fused = Some((id, bx));
+            if let Some((id, _)) = self.find_fused(key) {
                 if self.exact_updates() {
                     let l = self.log_odds[id as usize];
                     if !self.keeps_value(l, self.updated(l, hit)) {
@@ -483,6 +513,7 @@ impl RtreeGrid {
     /// (`O(n)`; runs automatically after a scan once half the cell ids are dead).
     pub fn compact(&mut self) {
         self.last_fused = None;
+        self.fused_cache.clear();
         let map = self.tree.compact();
         let mut log_odds = vec![0.0f32; self.tree.len()];
         for (old, &new) in map.iter().enumerate() {
