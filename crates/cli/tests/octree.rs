@@ -64,6 +64,7 @@ fn room_graph_follows_the_json_contract_and_fuses() {
         "points",
         "resolution_m",
         "model",
+        "fusion",
         "max_entries",
         "min_entries",
         "nodes",
@@ -106,6 +107,42 @@ fn room_graph_follows_the_json_contract_and_fuses() {
     ]));
     // The end-point model knows only occupied cells.
     assert_eq!(endpoint["occupied_leaves"], endpoint["leaves"]);
+}
+
+#[test]
+fn equal_value_fusion_keeps_the_volume_and_fuses_a_single_scan() {
+    let dir = tempfile::tempdir().unwrap();
+    let graph = room_graph(dir.path(), 1);
+    let graph = graph.to_str().unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["octree", graph, "--resolution", "0.2", "--json"];
+        args.extend_from_slice(extra);
+        json_of(&raypath(&args))
+    };
+    let clamped = run(&[]);
+    let equal = run(&["--fusion", "equal"]);
+    let plain = run(&["--no-fusion"]);
+    assert_eq!(clamped["fusion"], "clamped");
+    assert_eq!(equal["fusion"], "equal");
+    // One scan clamps nothing: the thesis' rule cannot fuse, ours fuses the free space seen
+    // once; both cover the same base cubes as the plain grid.
+    assert_eq!(clamped["fused_leaves"], 0);
+    assert!(equal["fused_leaves"].as_u64().unwrap() > 0);
+    assert!(equal["leaves"].as_u64().unwrap() * 2 < plain["leaves"].as_u64().unwrap());
+    assert_eq!(equal["base_cubes"], plain["base_cubes"]);
+    assert!(equal["occupied_leaves"].as_u64().unwrap() > 0);
+    let bad = raypath(&[
+        "octree",
+        graph,
+        "--resolution",
+        "0.2",
+        "--fusion",
+        "mean",
+        "--json",
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    let json: serde_json::Value = serde_json::from_slice(&bad.stdout).unwrap();
+    assert!(json["error"].as_str().unwrap().contains("fusion rule"));
 }
 
 #[test]

@@ -24,7 +24,7 @@ use std::fmt::Write;
 use std::time::Instant;
 
 use anyhow::Result;
-use raypath_rtree_grid::{GridConfig, Occupancy, RtreeGrid, Selection, SensorModel};
+use raypath_rtree_grid::{FusionRule, GridConfig, Occupancy, RtreeGrid, Selection, SensorModel};
 use serde_json::json;
 
 use super::{EvalContext, EvalReport};
@@ -33,6 +33,46 @@ use data::Dataset;
 use peer::PeerRun;
 
 const NAME: &str = "octomap";
+
+/// Variant label of the equal-value rule with the thesis' selection.
+const EQUAL_LABEL: &str = "equal-value fusion + split-on-update (ours, beam samples)";
+/// Variant label of the equal-value rule seeded from every updated cell.
+const EQUAL_UPDATED_LABEL: &str = "equal-value fusion + split-on-update (ours, every updated cell)";
+
+/// Sums for the equal-value rule over the summary's data sets (as for the thesis' rule).
+#[derive(Default)]
+struct EqualSums {
+    ours_insert: f64,
+    peer_insert: f64,
+    ours_bytes: usize,
+    peer_bytes: usize,
+    reduction: Option<(String, f64)>,
+    geb079: Option<(f64, f64, f64)>,
+}
+
+impl EqualSums {
+    fn insertion_ratio(&self) -> Option<f64> {
+        (self.peer_insert > 0.0).then(|| self.ours_insert / self.peer_insert)
+    }
+
+    fn bytes_ratio(&self) -> Option<f64> {
+        (self.peer_bytes > 0).then(|| self.ours_bytes as f64 / self.peer_bytes as f64)
+    }
+
+    fn json(&self) -> serde_json::Value {
+        json!({
+            "leaf_reduction_vs_pruned_octomap_0_2m": self.reduction.as_ref().map(|r| r.1),
+            "leaf_reduction_data": self.reduction.as_ref().map(|r| r.0.clone()),
+            "insertion_time_ratio_vs_octomap": self.insertion_ratio(),
+            "bytes_ratio_vs_octomap": self.bytes_ratio(),
+            "geb079": self.geb079.map(|(red, ins, b)| json!({
+                "leaf_reduction_vs_pruned_octomap_0_2m": red,
+                "insertion_time_ratio_vs_octomap": ins,
+                "bytes_ratio_vs_octomap": b,
+            })),
+        })
+    }
+}
 
 /// Our side of one configuration.
 struct OursRun {
@@ -240,6 +280,9 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     let mut geb079_02: Option<(f64, f64, f64)> = None;
     // Per data set, model and resolution at M = 8: leaves and µs/point, ours and OctoMap's.
     let mut plot_rows: Vec<PlotRow> = Vec::new();
+    // The equal-value rule (beam samples; every updated cell) at r = 0.2 m, M = 8, beam.
+    let mut equal_02: [EqualSums; 2] = Default::default();
+    let mut variant_rows = Vec::new();
     let mut variants = Table::new([
         "data",
         "variant",
@@ -296,9 +339,68 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
                                 ..base
                             },
                         ),
+                        (
+                            EQUAL_LABEL,
+                            GridConfig {
+                                fusion_rule: FusionRule::EqualValue,
+                                ..base
+                            },
+                        ),
+                        (
+                            EQUAL_UPDATED_LABEL,
+                            GridConfig {
+                                fusion_rule: FusionRule::EqualValue,
+                                selection: Selection::UpdatedCells,
+                                ..base
+                            },
+                        ),
                     ];
                     for (label, config) in cases {
                         let ours = run_config(set, config)?;
+                        let rule = match config.fusion_rule {
+                            FusionRule::Clamped => "clamped",
+                            FusionRule::EqualValue => "equal",
+                        };
+                        let selection = match config.selection {
+                            Selection::BeamSamples { .. } => "beam-samples",
+                            Selection::UpdatedCells => "updated-cells",
+                        };
+                        variant_rows.push(json!({
+                            "data": set.name, "variant": label, "fusion": config.fusion,
+                            "fusion_rule": rule, "selection": selection,
+                            "split_on_unclamp": config.split_on_unclamp,
+                            "leaves": ours.leaves, "fused_leaves": ours.fused, "bytes": ours.bytes,
+                            "insert_secs": ours.insert_secs,
+                            "leaf_reduction": peer.as_ref().map(|p| 1.0 - ours.leaves as f64 / p.leaves as f64),
+                            "insertion_time_ratio": peer.as_ref().map(|p| ours.insert_secs / p.insert_secs),
+                            "bytes_ratio": peer.as_ref().map(|p| ours.bytes as f64 / p.memory_bytes as f64),
+                        }));
+                        if let (Some(p), Some(k)) = (
+                            &peer,
+                            [EQUAL_LABEL, EQUAL_UPDATED_LABEL]
+                                .iter()
+                                .position(|l| *l == label),
+                        ) {
+                            let e = &mut equal_02[k];
+                            if set.name == "geb079" {
+                                e.geb079 = Some((
+                                    1.0 - ours.leaves as f64 / p.leaves as f64,
+                                    ours.insert_secs / p.insert_secs,
+                                    ours.bytes as f64 / p.memory_bytes as f64,
+                                ));
+                            } else {
+                                e.ours_insert += ours.insert_secs;
+                                e.peer_insert += p.insert_secs;
+                                e.ours_bytes += ours.bytes;
+                                e.peer_bytes += p.memory_bytes;
+                                if e.reduction.is_none() || set.name == "urban" {
+                                    e.reduction = Some((
+                                        set.name.clone(),
+                                        1.0 - ours.leaves as f64 / p.leaves as f64,
+                                    ));
+                                }
+                            }
+                        }
                         variants.row([
                             set.name.clone(),
                             label.to_owned(),
@@ -469,7 +571,36 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             "thesis: 28.51 % / > 1 / —; aim ≥ 28.5 % / ≤ 1 / < 1".into(),
         ]);
     }
+    for (sums, label) in equal_02.iter().zip(["beam samples", "every updated cell"]) {
+        summary.row([
+            format!(
+                "equal-value rule (ours, {label}): leaf reduction ({}) / insertion ratio / bytes ratio",
+                sums.reduction.as_ref().map_or("—", |r| r.0.as_str())
+            ),
+            format!(
+                "{} / {} / {}",
+                sums.reduction
+                    .as_ref()
+                    .map_or("—".into(), |r| format!("{:.2} %", 100.0 * r.1)),
+                sums.insertion_ratio().map_or("—".into(), |v| fmt_num(v, 2)),
+                sums.bytes_ratio().map_or("—".into(), |v| fmt_num(v, 2)),
+            ),
+            "not in the thesis (our extension); aim ≥ 28.5 % / ≤ 1 / < 1".into(),
+        ]);
+    }
     md.push_str(&summary.to_markdown());
+    writeln!(
+        md,
+        "\nThe equal-value rule is our extension beyond Khan 2017: cells whose log-odds are \
+         bit-equal fuse, clamped or not (OctoMap's pruning rule — 8 siblings with equal \
+         log-odds — but with cuboids grown in the thesis' search-direction order). The map \
+         stays exact: a fused cell whose value a scan changes for only part of its base cubes \
+         is split (the changed cubes, plus halving cuboids with the old value) before the \
+         updates apply, so each base cube holds the log-odds of an unfused lattice. Rows in \
+         the Variants table; figures under `summary.equal_value` (thesis selection) and \
+         `summary.equal_value_updated_cells` in the JSON, which also lists every variant \
+         under `variants`.\n"
+    )?;
     writeln!(
         md,
         "\nThe summary keys of `target/eval/octomap.json` keep their meaning: the leaf \
@@ -499,7 +630,8 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         md,
         "\n## Variants (beam-based, r = 0.2 m, M = 8)\n\nThe thesis fuses only clamped cells, \
          starting from end-point cells and cells sampled along the beams; the variants show \
-         what the selection and the optional split-back (the thesis' future work) change.\n"
+         what the selection, the optional split-back (the thesis' future work) and our \
+         equal-value rule (exact, with split-on-update) change.\n"
     )?;
     md.push_str(&variants.to_markdown());
     writeln!(
@@ -524,6 +656,8 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             "insertion_time_ratio_vs_octomap": insertion_ratio,
             "bytes_ratio_vs_octomap": bytes_ratio,
             "octomap_available": driver.is_ok(),
+            "equal_value": equal_02[0].json(),
+            "equal_value_updated_cells": equal_02[1].json(),
             "geb079": geb079_02.map(|(red, ins, b)| json!({
                 "leaf_reduction_vs_pruned_octomap_0_2m": red,
                 "insertion_time_ratio_vs_octomap": ins,
@@ -531,6 +665,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             })),
         },
         "runs": rows,
+        "variants": variant_rows,
     });
     Ok(EvalReport {
         name: NAME,

@@ -7,9 +7,13 @@
 //! compressed, sensor at the origin — OctoMap's `scan.dat`).
 //!
 //! Prints nodes, leaves, bytes and times; `--json` prints one object with the keys
-//! `input`, `scans`, `points`, `resolution_m`, `model`, `max_entries`, `min_entries`,
+//! `input`, `scans`, `points`, `resolution_m`, `model`, `fusion`, `max_entries`, `min_entries`,
 //! `nodes`, `leaves`, `occupied_leaves`, `fused_leaves`, `height`, `base_cubes`, `bytes`,
 //! `insert_secs`, `insert_us_per_point`, `access_secs`, `out`.
+//! `--fusion clamped` (default) is the thesis' rule: only clamped cells fuse. `--fusion equal`
+//! is our extension: cells with bit-equal log-odds fuse (OctoMap's pruning rule, with
+//! cuboids), and fused cells are split where a scan changes part of them, so the map equals
+//! an unfused grid at every base cube.
 //! `--out FILE` writes the map: `.bt` as an OctoMap tree at the base resolution, `.ply` as a
 //! mesh of the occupied cuboids.
 
@@ -19,7 +23,7 @@ use std::time::Instant;
 use raypath_geometry::{PointCloud, Pose3};
 use raypath_io::kitti::KittiSequence;
 use raypath_io::octomap::read_graph;
-use raypath_rtree_grid::{GridConfig, RtreeGrid, SensorModel};
+use raypath_rtree_grid::{FusionRule, GridConfig, RtreeGrid, SensorModel};
 use serde_json::json;
 
 use super::Failure;
@@ -44,6 +48,10 @@ pub struct Args {
     /// Use at most this many scans.
     #[arg(long, value_name = "N")]
     pub scans: Option<usize>,
+    /// Fusion rule: clamped (the thesis: only clamped cells fuse) or equal (ours: cells with
+    /// equal log-odds fuse, split again on partial updates; the map stays exact).
+    #[arg(long, default_value = "clamped", value_name = "RULE")]
+    pub fusion: String,
     /// Disable cell fusion (a plain grid in the R-tree).
     #[arg(long)]
     pub no_fusion: bool,
@@ -143,6 +151,16 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             ));
         }
     };
+    let fusion_rule = match args.fusion.as_str() {
+        "clamped" => FusionRule::Clamped,
+        "equal" => FusionRule::EqualValue,
+        other => {
+            return Err(Failure::input(
+                format!("unknown fusion rule {other:?}; choose clamped or equal"),
+                args.json,
+            ));
+        }
+    };
     if let Some(out) = &args.out {
         let name = out.to_string_lossy().to_lowercase();
         if !(name.ends_with(".bt") || name.ends_with(".ply")) {
@@ -155,6 +173,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let mut config = GridConfig::with(args.resolution, args.max_entries, model);
     config.max_range_m = args.max_range;
     config.fusion = !args.no_fusion;
+    config.fusion_rule = fusion_rule;
     let mut grid = RtreeGrid::new(config).map_err(|e| Failure::input(e, args.json))?;
     let scans = load(args)?;
     let points: usize = scans.iter().map(|(_, c)| c.num_valid()).sum();
@@ -181,6 +200,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "points": points,
             "resolution_m": args.resolution,
             "model": args.model,
+            "fusion": args.fusion,
             "max_entries": config.max_entries,
             "min_entries": config.min_entries,
             "nodes": stats.nodes,
@@ -198,11 +218,12 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         println!("{doc}");
     } else {
         println!(
-            "{}: {} scans, {points} points, r = {} m, {} model, M = {}",
+            "{}: {} scans, {points} points, r = {} m, {} model, {} fusion, M = {}",
             args.input.display(),
             scans.len(),
             args.resolution,
             args.model,
+            args.fusion,
             config.max_entries
         );
         println!(
