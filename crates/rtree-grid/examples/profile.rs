@@ -20,6 +20,7 @@ fn main() {
     let r: f64 = args.get(2).map_or(0.2, |s| s.parse().unwrap());
     let only: Option<&str> = args.get(3).map(String::as_str);
     let max_scans: usize = args.get(4).map_or(usize::MAX, |s| s.parse().unwrap());
+    let interval: u32 = args.get(5).map_or(1, |s| s.parse().unwrap());
     for (label, fusion, model, rule, selection) in [
         (
             "beam, clamped",
@@ -70,6 +71,7 @@ fn main() {
         let mut config = GridConfig::with(r, 8, model);
         config.fusion = fusion;
         config.fusion_rule = rule;
+        config.fusion_interval_scans = interval;
         if let Some(selection) = selection {
             config.selection = selection;
         }
@@ -82,6 +84,7 @@ fn main() {
             keys += u.free_keys + u.occupied_keys;
             splits += u.splits;
         }
+        grid.fuse_pending();
         let secs = t.elapsed().as_secs_f64();
         grid.shrink_to_fit();
         let s = grid.stats();

@@ -92,6 +92,12 @@ pub struct GridConfig {
     pub split_on_unclamp: bool,
     /// Which cells may fuse (the thesis' clamped rule by default).
     pub fusion_rule: FusionRule,
+    /// Fuse after every this many scans (≥ 1; the thesis: 1). The cells selected by the
+    /// scans in between are kept and all start fusions then;
+    /// [`RtreeGrid::fuse_pending`](crate::RtreeGrid::fuse_pending) runs them at any time.
+    /// With [`FusionRule::EqualValue`] the map's values do not depend on it, only how often
+    /// fused cells are split and re-fused.
+    pub fusion_interval_scans: u32,
 }
 
 impl Default for GridConfig {
@@ -112,6 +118,7 @@ impl Default for GridConfig {
             seed: 7,
             split_on_unclamp: false,
             fusion_rule: FusionRule::Clamped,
+            fusion_interval_scans: 1,
         }
     }
 }

@@ -132,6 +132,9 @@ impl RtreeGrid {
                 return bad("max range must be positive");
             }
         }
+        if config.fusion_interval_scans == 0 {
+            return bad("fusion interval must be at least one scan");
+        }
         if let Selection::BeamSamples { spacing_cells } = config.selection {
             if !(spacing_cells >= 1.0 && spacing_cells.is_finite()) {
                 return bad("sample spacing must be at least one cell");
@@ -280,8 +283,8 @@ impl RtreeGrid {
         }
         update.free_keys = free_keys.len();
         update.occupied_keys = occupied_keys.len();
+        // Cells selected by earlier scans of this fusion interval stay selected.
         let mut selected = std::mem::take(&mut self.selected);
-        selected.clear();
         let fusion = self.config.fusion;
         for (keys, hit) in [(&free_keys, false), (&occupied_keys, true)] {
             for &packed in keys.iter() {
@@ -297,21 +300,32 @@ impl RtreeGrid {
         }
         self.apply_fused_updates();
         self.apply_exact_updates(&mut selected, &mut update);
-        if fusion {
-            selected.sort_unstable();
-            selected.dedup();
-            for &id in &selected {
-                update.fusions += self.fuse(id);
-            }
-        }
         self.scans += 1;
+        self.selected = selected;
+        if fusion && self.scans % u64::from(self.config.fusion_interval_scans) == 0 {
+            update.fusions += self.fuse_pending();
+        }
         if self.free_cells.len() > 4096 && self.free_cells.len() * 2 > self.log_odds.len() {
             self.compact();
         }
         self.free_keys = free_keys;
         self.occupied_keys = occupied_keys;
-        self.selected = selected;
         update
+    }
+
+    /// Runs the fusions of the cells selected since the last fusion pass (those of the
+    /// scans inside a [`GridConfig::fusion_interval_scans`]); returns the fusion steps.
+    pub fn fuse_pending(&mut self) -> usize {
+        let mut selected = std::mem::take(&mut self.selected);
+        selected.sort_unstable();
+        selected.dedup();
+        let mut steps = 0;
+        for &id in &selected {
+            steps += self.fuse(id);
+        }
+        selected.clear();
+        self.selected = selected;
+        steps
     }
 
     /// The id of the cell containing base cube `key`.
@@ -524,6 +538,13 @@ impl RtreeGrid {
         }
         self.log_odds = log_odds;
         self.free_cells = Vec::new();
+        // Pending fusion seeds follow the renumbering (dead ids are dropped).
+        self.selected = self
+            .selected
+            .iter()
+            .filter_map(|&old| map.get(old as usize).copied())
+            .filter(|&new| new != u32::MAX)
+            .collect();
         let mut index = LatticeIndex::with_capacity(self.tree.len() - self.fused_cells);
         let tree = &self.tree;
         tree.for_each_item(&mut |id, bx| {
@@ -542,7 +563,7 @@ impl RtreeGrid {
         self.free_cells.shrink_to_fit();
         self.free_keys = Vec::new();
         self.occupied_keys = Vec::new();
-        self.selected = Vec::new();
+        self.selected.shrink_to_fit(); // pending fusion seeds are kept
         self.touched_fused = Vec::new();
         self.touched_exact = Vec::new();
     }

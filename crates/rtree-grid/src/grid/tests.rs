@@ -302,6 +302,7 @@ proptest! {
         updated in any::<bool>(),
         equal in any::<bool>(),
         scans in 1usize..7,
+        interval in 1u32..4,
     ) {
         let model = if endpoint { SensorModel::BeamEndPoint } else { SensorModel::BeamBased };
         let mut config = GridConfig::with(0.25, m, model);
@@ -313,6 +314,7 @@ proptest! {
         } else {
             config.split_on_unclamp = true;
         }
+        config.fusion_interval_scans = interval;
         let data = moving_scans(seed, scans, 250);
         let mut grid = RtreeGrid::new(config).unwrap();
         let mut reference = RtreeGrid::new(GridConfig { fusion: false, ..config }).unwrap();
@@ -321,6 +323,8 @@ proptest! {
             reference.insert_scan(origin, points);
             assert_matches_plain(&grid, &reference, if equal { 0.0 } else { 2.0 * CLAMP_EPS });
         }
+        grid.fuse_pending();
+        assert_matches_plain(&grid, &reference, if equal { 0.0 } else { 2.0 * CLAMP_EPS });
         if equal && updated && !endpoint {
             // Free cells seen once share one value: something fused.
             prop_assert!(grid.stats().fused_leaves > 0);

@@ -51,6 +51,7 @@ pub struct RTree {
     min_entries: usize,
     cap: usize,
     item_boxes: Vec<KeyBox>,
+    item_leaf: Vec<u32>,
     inner_boxes: Vec<KeyBox>,
     box_block: Vec<u32>,
     free_blocks: Vec<u32>,
@@ -82,6 +83,7 @@ impl RTree {
             min_entries,
             cap: max_entries + 1,
             item_boxes: Vec::new(),
+            item_leaf: Vec::new(),
             inner_boxes: Vec::new(),
             box_block: Vec::new(),
             free_blocks: Vec::new(),
@@ -133,6 +135,7 @@ impl RTree {
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of;
         (self.item_boxes.capacity() + self.inner_boxes.capacity()) * size_of::<KeyBox>()
+            + self.item_leaf.capacity() * 4
             + (self.box_block.capacity() + self.free_blocks.capacity()) * 4
             + self.ids.capacity() * 4
             + self.count.capacity()
@@ -144,9 +147,12 @@ impl RTree {
             + size_of::<Self>()
     }
 
-    /// Releases spare capacity of the arena.
+    /// Releases spare capacity of the arena and drops the item → leaf map that speeds up
+    /// removals (4 bytes per item; refilled as items are inserted or move).
     pub fn shrink_to_fit(&mut self) {
         self.item_boxes.shrink_to_fit();
+        // The item → leaf map only speeds up removals; it is rebuilt as items move.
+        self.item_leaf = Vec::new();
         self.inner_boxes.shrink_to_fit();
         self.box_block.shrink_to_fit();
         self.free_blocks.shrink_to_fit();
@@ -285,6 +291,10 @@ impl RTree {
                 self.item_boxes.resize(id + 1, KeyBox::cube([0; 3]));
             }
             self.item_boxes[id] = bx;
+            if id >= self.item_leaf.len() {
+                self.item_leaf.resize(self.item_boxes.len(), NONE);
+            }
+            self.item_leaf[id] = node;
         }
     }
 
@@ -386,7 +396,17 @@ impl RTree {
     /// FindLeaf, remove, CondenseTree, shorten the tree).
     pub fn remove(&mut self, item: u32) -> Option<KeyBox> {
         let bx = self.item_box(item)?;
-        let (leaf, i) = self.find_leaf(self.root, item, &bx)?;
+        // The leaf node last holding the item (kept by push_entry), else a search.
+        let remembered = self.item_leaf.get(item as usize).and_then(|&leaf| {
+            (leaf != NONE && (leaf as usize) < self.count.len() && self.level[leaf as usize] == 0)
+                .then(|| (0..self.len_of(leaf)).find(|&i| self.id_at(leaf, i) == item))
+                .flatten()
+                .map(|i| (leaf, i))
+        });
+        let (leaf, i) = match remembered {
+            Some(found) => found,
+            None => self.find_leaf(self.root, item, &bx)?,
+        };
         self.remove_slot(leaf, i);
         self.len -= 1;
         self.condense(leaf);
@@ -573,6 +593,7 @@ impl RTree {
             box_block: Vec::with_capacity(self.num_nodes()),
             inner_boxes: Vec::new(),
             item_boxes: Vec::with_capacity(self.len),
+            item_leaf: Vec::with_capacity(self.len),
         };
         let mut item_map = vec![NONE; self.item_boxes.len()];
         self.copy_node(self.root, NONE, &mut out, &mut item_map);
@@ -583,6 +604,7 @@ impl RTree {
         self.box_block = out.box_block;
         self.inner_boxes = out.inner_boxes;
         self.item_boxes = out.item_boxes;
+        self.item_leaf = out.item_leaf;
         self.free_nodes = Vec::new();
         self.free_blocks = Vec::new();
         self.root = 0;
@@ -611,6 +633,7 @@ impl RTree {
             let new_child = if level == 0 {
                 let id = out.item_boxes.len() as u32;
                 out.item_boxes.push(self.item_boxes[child as usize]);
+                out.item_leaf.push(new);
                 item_map[child as usize] = id;
                 id
             } else {
@@ -684,4 +707,5 @@ struct Compacted {
     box_block: Vec<u32>,
     inner_boxes: Vec<KeyBox>,
     item_boxes: Vec<KeyBox>,
+    item_leaf: Vec<u32>,
 }
