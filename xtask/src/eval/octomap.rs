@@ -39,6 +39,9 @@ const EQUAL_LABEL: &str = "equal-value fusion + split-on-update (ours, beam samp
 /// Variant label of the equal-value rule seeded from every updated cell.
 const EQUAL_UPDATED_LABEL: &str = "equal-value fusion + split-on-update (ours, every updated cell)";
 
+/// Variant label of the equal-value rule fusing every 10 scans and after the last one.
+const EQUAL_BATCH_LABEL: &str = "equal-value fusion + split-on-update (ours, beam samples, fused every 10 scans and at the end)";
+
 /// Sums for the equal-value rule over the summary's data sets (as for the thesis' rule).
 #[derive(Default)]
 struct EqualSums {
@@ -97,6 +100,8 @@ fn run_config(set: &Dataset, config: GridConfig) -> Result<OursRun> {
     for node in &set.graph.nodes {
         grid.insert_cloud(&node.world_from_sensor, &node.points);
     }
+    // Fusions still pending with a fusion interval > 1 scan (a no-op otherwise).
+    grid.fuse_pending();
     let insert_secs = started.elapsed().as_secs_f64();
     grid.shrink_to_fit();
     let started = Instant::now();
@@ -281,7 +286,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     // Per data set, model and resolution at M = 8: leaves and µs/point, ours and OctoMap's.
     let mut plot_rows: Vec<PlotRow> = Vec::new();
     // The equal-value rule (beam samples; every updated cell) at r = 0.2 m, M = 8, beam.
-    let mut equal_02: [EqualSums; 2] = Default::default();
+    let mut equal_02: [EqualSums; 3] = Default::default();
     let mut variant_rows = Vec::new();
     let mut variants = Table::new([
         "data",
@@ -354,6 +359,14 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
                                 ..base
                             },
                         ),
+                        (
+                            EQUAL_BATCH_LABEL,
+                            GridConfig {
+                                fusion_rule: FusionRule::EqualValue,
+                                fusion_interval_scans: 10,
+                                ..base
+                            },
+                        ),
                     ];
                     for (label, config) in cases {
                         let ours = run_config(set, config)?;
@@ -369,6 +382,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
                             "data": set.name, "variant": label, "fusion": config.fusion,
                             "fusion_rule": rule, "selection": selection,
                             "split_on_unclamp": config.split_on_unclamp,
+                            "fusion_interval_scans": config.fusion_interval_scans,
                             "leaves": ours.leaves, "fused_leaves": ours.fused, "bytes": ours.bytes,
                             "insert_secs": ours.insert_secs,
                             "leaf_reduction": peer.as_ref().map(|p| 1.0 - ours.leaves as f64 / p.leaves as f64),
@@ -571,7 +585,11 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             "thesis: 28.51 % / > 1 / —; aim ≥ 28.5 % / ≤ 1 / < 1".into(),
         ]);
     }
-    for (sums, label) in equal_02.iter().zip(["beam samples", "every updated cell"]) {
+    for (sums, label) in equal_02.iter().zip([
+        "beam samples",
+        "every updated cell",
+        "beam samples, fused every 10 scans",
+    ]) {
         summary.row([
             format!(
                 "equal-value rule (ours, {label}): leaf reduction ({}) / insertion ratio / bytes ratio",
@@ -598,8 +616,10 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          is split (the changed cubes, plus halving cuboids with the old value) before the \
          updates apply, so each base cube holds the log-odds of an unfused lattice. Rows in \
          the Variants table; figures under `summary.equal_value` (thesis selection) and \
-         `summary.equal_value_updated_cells` in the JSON, which also lists every variant \
-         under `variants`.\n"
+         `summary.equal_value_updated_cells` and `summary.equal_value_every_10_scans` (fusion \
+         every 10 scans and after the last; the map's values do not depend on when fusion \
+         runs, only how often fused cells are split and re-fused) in the JSON, which also \
+         lists every variant under `variants`.\n"
     )?;
     writeln!(
         md,
@@ -658,6 +678,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             "octomap_available": driver.is_ok(),
             "equal_value": equal_02[0].json(),
             "equal_value_updated_cells": equal_02[1].json(),
+            "equal_value_every_10_scans": equal_02[2].json(),
             "geb079": geb079_02.map(|(red, ins, b)| json!({
                 "leaf_reduction_vs_pruned_octomap_0_2m": red,
                 "insertion_time_ratio_vs_octomap": ins,
