@@ -4,7 +4,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Point3;
-use raypath_rtree_grid::{GridConfig, RtreeGrid, SensorModel};
+use raypath_rtree_grid::{FusionRule, GridConfig, RtreeGrid, SensorModel};
 
 fn room_scan(n: usize) -> Vec<Point3<f64>> {
     (0..n)
@@ -34,6 +34,25 @@ fn bench(c: &mut Criterion) {
                     let mut grid = RtreeGrid::new(GridConfig::with(0.2, 8, model)).unwrap();
                     for _ in 0..3 {
                         grid.insert_scan(&Point3::origin(), &scan);
+                    }
+                    grid.num_leaves()
+                })
+            },
+        );
+    }
+    // A moving sensor (0.5 m per scan): later scans change parts of fused cells.
+    for rule in [FusionRule::Clamped, FusionRule::EqualValue] {
+        c.bench_function(
+            &format!("insert 3 × 20k-beam scans, moving ({rule:?}, beam, r = 0.2, M = 8)"),
+            |b| {
+                b.iter(|| {
+                    let mut config = GridConfig::with(0.2, 8, SensorModel::BeamBased);
+                    config.fusion_rule = rule;
+                    let mut grid = RtreeGrid::new(config).unwrap();
+                    for i in 0..3 {
+                        let origin = Point3::new(0.5 * f64::from(i), 0.0, 0.0);
+                        let points: Vec<_> = scan.iter().map(|p| p + origin.coords).collect();
+                        grid.insert_scan(&origin, &points);
                     }
                     grid.num_leaves()
                 })

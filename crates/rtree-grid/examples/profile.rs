@@ -65,7 +65,11 @@ fn main() {
             None,
         ),
     ] {
-        if only.is_some_and(|o| !label.contains(o)) {
+        let skip = |o: &str| match o.strip_prefix('=') {
+            Some(exact) => label != exact,
+            None => !label.contains(o),
+        };
+        if only.is_some_and(skip) {
             continue;
         }
         let mut config = GridConfig::with(r, 8, model);

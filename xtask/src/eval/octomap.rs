@@ -391,7 +391,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
                         }));
                         if let (Some(p), Some(k)) = (
                             &peer,
-                            [EQUAL_LABEL, EQUAL_UPDATED_LABEL]
+                            [EQUAL_LABEL, EQUAL_UPDATED_LABEL, EQUAL_BATCH_LABEL]
                                 .iter()
                                 .position(|l| *l == label),
                         ) {
