@@ -1,5 +1,5 @@
 //! Criterion benches: `extract` (pole extraction from five HDL-64E-like scans in a KITTI
-//! local map, throughput in points) and `localize` (one predict + update of 5000 particles
+//! local map, throughput in points; `trace_only` is its hit/miss counting alone) and `localize` (one predict + update of 5000 particles
 //! with 15 online poles on a 500-pole map, throughput in updates).
 
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
@@ -7,7 +7,9 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::{Point2, Point3, Vector3};
 use raypath_geometry::{PointCloud, Pose2, Pose3};
-use raypath_poles::{FilterParams, Pole, PoleFilter, PoleParams, extract_poles};
+use raypath_poles::{
+    FilterParams, HitMissGrid, Pole, PoleFilter, PoleParams, extract_poles, local_grid,
+};
 
 /// Cylinders (x, y, r) on a street with two facades and the ground.
 const CYLINDERS: [(f64, f64, f64); 6] = [
@@ -78,6 +80,14 @@ fn bench_extract(c: &mut Criterion) {
     group.throughput(Throughput::Elements(points as u64));
     group.bench_function("kitti_local_map_5_scans", |b| {
         b.iter(|| extract_poles(&scans, &Point3::new(0.0, 0.0, 1.73), &params))
+    });
+    let grid = local_grid(&Point3::new(0.0, 0.0, 1.73), &params).expect("grid");
+    group.bench_function("kitti_local_map_5_scans_trace_only", |b| {
+        b.iter(|| {
+            let mut counts = HitMissGrid::new(grid);
+            counts.insert_scans_par(&scans, params.max_range_m);
+            counts.rays()
+        })
     });
     group.finish();
 }

@@ -344,6 +344,33 @@ impl Side {
     }
 }
 
+/// The side steps of a slab in which both side axes `A` and `B` (`A < B`) cross a
+/// boundary: first the one whose boundary comes first, i.e. with the larger fraction past it
+/// relative to its rate (ties to the higher axis, `B`). Returns the voxel after both.
+#[cold]
+#[inline(never)]
+fn both_sides(
+    misses: &mut [u16],
+    index: usize,
+    side_a: Side,
+    step_a: usize,
+    side_b: Side,
+    step_b: usize,
+) -> usize {
+    let a_first = side_a.fraction as u128 * side_b.per_slab as u128
+        > side_b.fraction as u128 * side_a.per_slab as u128;
+    let (first, second) = if a_first {
+        (step_a, step_b)
+    } else {
+        (step_b, step_a)
+    };
+    let index = index.wrapping_add(first);
+    count(misses, index, true);
+    let index = index.wrapping_add(second);
+    count(misses, index, true);
+    index
+}
+
 /// `value` when `keep` is 1, 0 when it is 0 (branch-free).
 #[inline(always)]
 fn masked(value: usize, keep: i64) -> usize {
@@ -380,19 +407,7 @@ impl Walk {
             count(misses, index, true);
             let (cross_a, cross_b) = (side_a.advance(), side_b.advance());
             if cross_a & cross_b != 0 {
-                // Both sides: the one whose boundary comes first, i.e. with the larger
-                // fraction past it relative to its rate (ties to the higher axis, `B`).
-                let a_first = side_a.fraction as u128 * side_b.per_slab as u128
-                    > side_b.fraction as u128 * side_a.per_slab as u128;
-                let (first, second) = if a_first {
-                    (step_a, step_b)
-                } else {
-                    (step_b, step_a)
-                };
-                index = index.wrapping_add(first);
-                count(misses, index, true);
-                index = index.wrapping_add(second);
-                count(misses, index, true);
+                index = both_sides(misses, index, side_a, step_a, side_b, step_b);
             } else {
                 let side = masked(step_a, cross_a) | masked(step_b, cross_b);
                 index = index.wrapping_add(side);
