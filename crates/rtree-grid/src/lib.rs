@@ -31,6 +31,14 @@
 //!   `insertPointCloud` rule, spec §2.D) and applied; fused cells get one update per scan.
 //! * **Fusion only from selected cells** (§2.F.1): end-point cells plus traversed cells drawn
 //!   at random ([`Selection`]); only clamped candidates are kept.
+//! * **Fused-cell look-ups without the tree.** Per 16³ block, a 64-bit mask of the 4³
+//!   sub-blocks fused cells touch; a direct-mapped cache (2¹⁶ slots) of the fused cell last
+//!   found per 4³ block; slabs of ≤ 64 base cubes checked cube by cube and larger ones
+//!   probed at up to 4³ spread points before the slab query; an item → leaf map (4 B per
+//!   cell, dropped by [`RtreeGrid::shrink_to_fit`]) so removals skip Guttman's FindLeaf.
+//! * **Fusion interval** ([`GridConfig::fusion_interval_scans`], default 1 = the thesis):
+//!   fusing every k scans (seeds accumulate; [`RtreeGrid::fuse_pending`] runs them) saves
+//!   the split / re-fuse churn of the equal-value rule on a moving sensor.
 //! * **Compaction.** Fusion frees cell ids and nodes; once half the ids are dead, an `O(n)`
 //!   pass renumbers cells in tree order and rebuilds the arenas ([`RtreeGrid::compact`]).
 //!
