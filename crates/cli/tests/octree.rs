@@ -131,6 +131,20 @@ fn equal_value_fusion_keeps_the_volume_and_fuses_a_single_scan() {
     assert!(equal["leaves"].as_u64().unwrap() * 2 < plain["leaves"].as_u64().unwrap());
     assert_eq!(equal["base_cubes"], plain["base_cubes"]);
     assert!(equal["occupied_leaves"].as_u64().unwrap() > 0);
+    // An interval longer than the graph: the pending fusions run after the last scan.
+    let batch = run(&["--fusion", "equal", "--fusion-interval", "4"]);
+    assert_eq!(batch["fusion_interval_scans"], 4);
+    assert_eq!(batch["base_cubes"], plain["base_cubes"]);
+    assert!(batch["fused_leaves"].as_u64().unwrap() > 0);
+    let zero = raypath(&[
+        "octree",
+        graph,
+        "--resolution",
+        "0.2",
+        "--fusion-interval",
+        "0",
+    ]);
+    assert_eq!(zero.status.code(), Some(2));
     let bad = raypath(&[
         "octree",
         graph,

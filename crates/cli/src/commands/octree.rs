@@ -7,7 +7,8 @@
 //! compressed, sensor at the origin — OctoMap's `scan.dat`).
 //!
 //! Prints nodes, leaves, bytes and times; `--json` prints one object with the keys
-//! `input`, `scans`, `points`, `resolution_m`, `model`, `fusion`, `max_entries`, `min_entries`,
+//! `input`, `scans`, `points`, `resolution_m`, `model`, `fusion`, `fusion_interval_scans`,
+//! `max_entries`, `min_entries`,
 //! `nodes`, `leaves`, `occupied_leaves`, `fused_leaves`, `height`, `base_cubes`, `bytes`,
 //! `insert_secs`, `insert_us_per_point`, `access_secs`, `out`.
 //! `--fusion clamped` (default) is the thesis' rule: only clamped cells fuse. `--fusion equal`
@@ -52,6 +53,10 @@ pub struct Args {
     /// equal log-odds fuse, split again on partial updates; the map stays exact).
     #[arg(long, default_value = "clamped", value_name = "RULE")]
     pub fusion: String,
+    /// Fuse after every this many scans (1: the thesis; larger: fewer splits of fused cells
+    /// on a moving sensor; pending fusions run after the last scan).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pub fusion_interval: u32,
     /// Disable cell fusion (a plain grid in the R-tree).
     #[arg(long)]
     pub no_fusion: bool,
@@ -174,6 +179,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     config.max_range_m = args.max_range;
     config.fusion = !args.no_fusion;
     config.fusion_rule = fusion_rule;
+    config.fusion_interval_scans = args.fusion_interval;
     let mut grid = RtreeGrid::new(config).map_err(|e| Failure::input(e, args.json))?;
     let scans = load(args)?;
     let points: usize = scans.iter().map(|(_, c)| c.num_valid()).sum();
@@ -181,6 +187,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     for (pose, cloud) in &scans {
         grid.insert_cloud(pose, cloud);
     }
+    grid.fuse_pending();
     let insert_secs = started.elapsed().as_secs_f64();
     grid.shrink_to_fit();
     let started = Instant::now();
@@ -201,6 +208,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "resolution_m": args.resolution,
             "model": args.model,
             "fusion": args.fusion,
+            "fusion_interval_scans": config.fusion_interval_scans,
             "max_entries": config.max_entries,
             "min_entries": config.min_entries,
             "nodes": stats.nodes,
