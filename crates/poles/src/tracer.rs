@@ -335,6 +335,13 @@ impl Side {
         }
     }
 
+    /// The side boundaries crossed in the next `slabs` slabs (what `slabs` calls of
+    /// [`Side::advance`] add up to, the same integer sum without the carries).
+    fn crossings(&self, slabs: usize) -> usize {
+        let position = self.fraction as i128 + slabs as i128 * self.per_slab as i128;
+        (position >> FRACTION_BITS).max(0) as usize
+    }
+
     /// Moves to the next major boundary: 1 when a side boundary comes before it, else 0.
     #[inline(always)]
     fn advance(&mut self) -> i64 {
@@ -401,7 +408,7 @@ impl Walk {
         let mut side_a = Side::new(self.t[A], self.dt[A], self.left[A] > 0, t_major, dt_major);
         let mut side_b = Side::new(self.t[B], self.dt[B], self.left[B] > 0, t_major, dt_major);
         let [step_a, step_b, step_m] = [self.index_step[A], self.index_step[B], self.index_step[M]];
-        let (mut crossed_a, mut crossed_b) = (0usize, 0usize);
+        let crossed = [side_a.crossings(slabs), side_b.crossings(slabs)];
         let mut index = self.index;
         for _ in 0..slabs {
             count(misses, index, true);
@@ -413,14 +420,12 @@ impl Walk {
                 index = index.wrapping_add(side);
                 count(misses, index, side != 0);
             }
-            crossed_a += cross_a as usize;
-            crossed_b += cross_b as usize;
             index = index.wrapping_add(step_m);
         }
         self.index = index;
         self.left[M] -= slabs;
         self.t[M] = t_major + slabs as f64 * dt_major;
-        for (axis, crossed) in [(A, crossed_a), (B, crossed_b)] {
+        for (axis, crossed) in [(A, crossed[0]), (B, crossed[1])] {
             self.left[axis] = self.left[axis].saturating_sub(crossed);
             self.t[axis] = if self.left[axis] == 0 {
                 f64::INFINITY
