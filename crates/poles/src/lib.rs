@@ -9,10 +9,11 @@
 //!
 //! A pole is a vertical stack of **occupied** voxels with a square footprint, surrounded by a
 //! hull of **free** voxels. Free space is only known by ray tracing, so the extractor builds
-//! a local 3-D grid of hit and miss counts from registered scans ([`HitMissGrid`]: the exact
-//! traversal of `raypath-geometry` specialised to linear-index stepping, one share of the
-//! points per thread; cost linear in the voxels crossed, ≈ 120 per ray in a KITTI local map,
-//! which makes tracing about two thirds of the extraction time), turns the counts into the
+//! a local 3-D grid of hit and miss counts from registered scans ([`HitMissGrid`]: an exact
+//! traversal walked slab by slab along the major axis with fixed-point side counters (no
+//! data-dependent branch per voxel), one share of the points per thread; cost linear in the
+//! voxels crossed, ≈ 120 per ray in a KITTI local map, which makes tracing about two thirds
+//! of the extraction time), turns the counts into the
 //! posterior probability that the reflection rate exceeds `μ_o` ([`ReflectionPrior`]:
 //! `o = 1 − I_{μ_o}(h + α, m + β)` with a method-of-moments Beta prior), and scores every
 //! voxel for every footprint width `a` (`q_a` = best placement of mean occupancy inside
