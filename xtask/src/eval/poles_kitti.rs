@@ -186,7 +186,12 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         "total [s]",
     ]);
     let mut summaries: Vec<RunSummary> = Vec::new();
-    for plan in plans(ctx.quick) {
+    let plans = plans(ctx.quick);
+    // The sequences this run covers, named in the report (`POLES_KITTI_SEQUENCES` may select).
+    let mut covered: Vec<&str> = plans.iter().map(|p| p.sequence).collect();
+    covered.dedup();
+    let covered = covered.join(", ");
+    for plan in plans {
         let dir = ctx.data(&format!("kitti-poles/{}", plan.sequence));
         if !dir.join("poses.txt").exists() {
             notes.push(format!(
@@ -382,7 +387,11 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          spread, 2 % odometry noise, 50 runs (†: {LONG_RUNS} runs on sequences of more than \
          {FULL_RUNS_MAX_SCANS} scans, for the time budget), errors every 1 m of ground-truth \
          arc length (means over runs).{}\n",
-        if ctx.quick { "07 and 06" } else { "00–07" },
+        if ctx.quick {
+            "07 and 06"
+        } else {
+            covered.as_str()
+        },
         if ctx.quick {
             " **Quick run: sequence 07 every 10th frame, first 30 scans, 3 runs; the \
              later-pass protocol on the first 8 scans of the revisit of sequence 06 (every 10th \
