@@ -639,47 +639,43 @@ const THESIS_ROWS: [[&str; 10]; 4] = [
     ],
 ];
 
-/// Ground-truth pole positions within `radius` of any of the poses.
-pub(super) fn truth_near(path: &Path, poses: &[Pose3], radius: f64) -> Result<Vec<Point2<f64>>> {
-    let poles = read_pole_csv(path)?;
-    Ok(poles
+/// The items whose ground-plane position `xy` lies within `radius` of any of the poses.
+fn within<T: Copy>(
+    items: &[T],
+    poses: &[Pose3],
+    radius: f64,
+    xy: impl Fn(&T) -> (f64, f64),
+) -> Vec<T> {
+    items
         .iter()
-        .filter(|p| {
+        .filter(|item| {
+            let (x, y) = xy(item);
             poses.iter().any(|q| {
                 let t = q.translation();
-                (t.x - p.x).powi(2) + (t.y - p.y).powi(2) <= radius * radius
+                (t.x - x).powi(2) + (t.y - y).powi(2) <= radius * radius
             })
         })
+        .copied()
+        .collect()
+}
+
+/// Ground-truth pole positions within `radius` of any of the poses.
+pub(super) fn truth_near(path: &Path, poses: &[Pose3], radius: f64) -> Result<Vec<Point2<f64>>> {
+    let poles: Vec<Point2<f64>> = read_pole_csv(path)?
+        .iter()
         .map(|p| Point2::new(p.x, p.y))
-        .collect())
+        .collect();
+    Ok(points_near(&poles, poses, radius))
 }
 
 /// The points within `radius` of any of the poses.
 fn points_near(points: &[Point2<f64>], poses: &[Pose3], radius: f64) -> Vec<Point2<f64>> {
-    points
-        .iter()
-        .filter(|p| {
-            poses.iter().any(|q| {
-                let t = q.translation();
-                (t.x - p.x).powi(2) + (t.y - p.y).powi(2) <= radius * radius
-            })
-        })
-        .copied()
-        .collect()
+    within(points, poses, radius, |p| (p.x, p.y))
 }
 
 /// The poles within `radius` of any of the poses.
 pub(super) fn near(poles: &[Pole], poses: &[Pose3], radius: f64) -> Vec<Pole> {
-    poles
-        .iter()
-        .filter(|p| {
-            poses.iter().any(|q| {
-                let t = q.translation();
-                (t.x - p.x).powi(2) + (t.y - p.y).powi(2) <= radius * radius
-            })
-        })
-        .copied()
-        .collect()
+    within(poles, poses, radius, |p| (p.x, p.y))
 }
 
 /// Means over runs of the Table 12.2 columns.

@@ -3,7 +3,7 @@
 
 use super::{RtreeGrid, SensorModel};
 use crate::config::FusionRule;
-use crate::key::KeyBox;
+use crate::key::{Key, KeyBox};
 
 /// One search direction: an axis and a sign.
 type Direction = (usize, bool);
@@ -150,20 +150,7 @@ impl RtreeGrid {
                     slab.lo[a]
                 }
             });
-            let id = match self.index.get(key, Self::key_of_cell(&self.tree)) {
-                Some(id) => id,
-                None if !self.coverage.may_contain(key) => return false, // unknown space
-                None => match self.fused_hint(key) {
-                    Some(id) => id,
-                    None => continue,
-                },
-            };
-            if !self.fuses_with(seed, self.log_odds[id as usize])
-                || !self
-                    .tree
-                    .item_box(id)
-                    .is_some_and(|b| slab.contains_box(&b))
-            {
+            if !self.probe_passes(key, slab, seed) {
                 return false;
             }
         }
@@ -222,6 +209,26 @@ impl RtreeGrid {
 }
 
 impl RtreeGrid {
+    /// One necessary condition of a slab fusion, checked with cheap look-ups (hash probe;
+    /// near fused cells the last-found cell and the block cache): the base cube `key` lies
+    /// in a known cell of a fusing value inside `slab`. `false` in unknown space or in a
+    /// cell that cannot join; a key the caches cannot place passes (the slab query decides).
+    fn probe_passes(&self, key: Key, slab: &KeyBox, seed: f32) -> bool {
+        let id = match self.index.get(key, Self::key_of_cell(&self.tree)) {
+            Some(id) => id,
+            None if !self.coverage.may_contain(key) => return false, // unknown space
+            None => match self.fused_hint(key) {
+                Some(id) => id,
+                None => return true,
+            },
+        };
+        self.fuses_with(seed, self.log_odds[id as usize])
+            && self
+                .tree
+                .item_box(id)
+                .is_some_and(|b| slab.contains_box(&b))
+    }
+
     /// Probes a lattice of up to 4 per axis spread over `slab`: `false` when a probe lies
     /// in unknown space or in a cell that cannot join the fusion (probes the caches cannot
     /// place pass).
@@ -236,20 +243,7 @@ impl RtreeGrid {
                         let k = u32::from(slab.lo[a]) + off[a] * steps[a] + steps[a] / 2;
                         k.min(u32::from(slab.hi[a])) as u16
                     });
-                    let id = match self.index.get(key, Self::key_of_cell(&self.tree)) {
-                        Some(id) => id,
-                        None if !self.coverage.may_contain(key) => return false,
-                        None => match self.fused_hint(key) {
-                            Some(id) => id,
-                            None => continue,
-                        },
-                    };
-                    if !self.fuses_with(seed, self.log_odds[id as usize])
-                        || !self
-                            .tree
-                            .item_box(id)
-                            .is_some_and(|b| slab.contains_box(&b))
-                    {
+                    if !self.probe_passes(key, slab, seed) {
                         return false;
                     }
                 }
