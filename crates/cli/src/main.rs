@@ -67,6 +67,10 @@ enum Command {
     ScanMatch(commands::scan_match::Args),
     /// Fit the intensity look-up table I_ref(r, α) from reference-surface samples (Khan ch. 3).
     CalibrateIntensity(commands::calibrate_intensity::Args),
+    /// Loop-closure detection (IBuILD, Khan ch. 4) or kidnapped-robot place recognition on a
+    /// CARMEN log, KITTI sequence or image folder; with ground truth, the precision–recall
+    /// summary.
+    LoopClosure(commands::loop_closure::Args),
 }
 
 fn main() -> ExitCode {
@@ -85,6 +89,7 @@ fn main() -> ExitCode {
         Command::DctMap(args) => commands::dct_map::run(args),
         Command::ScanMatch(args) => commands::scan_match::run(args),
         Command::CalibrateIntensity(args) => commands::calibrate_intensity::run(args),
+        Command::LoopClosure(args) => commands::loop_closure::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

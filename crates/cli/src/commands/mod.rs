@@ -4,6 +4,7 @@ pub mod calibrate_intensity;
 pub mod dct_map;
 pub mod info;
 pub mod localize;
+pub mod loop_closure;
 pub mod map;
 pub mod octree;
 pub mod planes;

@@ -1,0 +1,482 @@
+//! `raypath loop-closure`: loop-closure detection (IBuILD, Khan 2017, §4.4) or place
+//! recognition without temporal consistency (Khan 2017, §4.5) on a CARMEN log (front-laser
+//! scans), a KITTI sequence directory (velodyne scans) or a folder of PNG/JPEG images (sorted
+//! by file name), with the methods of `raypath_place_recognition`: `ibuild` (default), `dbow`,
+//! `scan-context`, `hog`, `gist`, `shot`, `polar`. Methods that cannot describe the input's
+//! frames (Scan Context and SHOT need point clouds, the polar descriptor planar scans) fail
+//! with exit code 2.
+//!
+//! Modes:
+//! - `online` (default): frame by frame, each frame queries the frames at least
+//!   `--exclusion-frames` before it, then joins the database; the best candidate is accepted
+//!   as a loop closure by the temporal-consistency test of Khan 2017, §4.4.3 (window
+//!   `--window` β, threshold `--min-score`).
+//! - `kidnapped`: every frame is inserted, then each queries the whole database (frames closer
+//!   than `--exclusion-frames` to it, itself included, are dropped from its list); a loop is
+//!   a best candidate with a score of at least `--min-score`, with no temporal test.
+//!
+//! `--ground-truth FILE` (a CARMEN corrected log — the input log itself when it is one —, a
+//! KITTI `poses.txt` or a TUM file `t x y z qx qy qz qw`) adds the precision–recall summary:
+//! same place = less than `--radius` metres apart (default 2 m with overlapping fields of view
+//! for planar scans, 5 m otherwise), pairs closer than `--exclusion-frames` frames or
+//! `--exclusion-seconds` seconds are not evaluated. Pairing of poses and frames: see `truth`.
+//!
+//! DBoW needs a vocabulary trained offline (`--vocabulary FILE`, as written by
+//! `--save-vocabulary`); without one it is trained on the input itself, with a warning: that
+//! is not the offline protocol of Gálvez-López & Tardós (2012), whose vocabulary comes from
+//! independent images, and flatters the method.
+//!
+//! `--json` prints exactly `{"method", "frames", "ms_per_query", "loops": [{"query", "match",
+//! "score"}], "candidates": [{"query", "match", "score"}]}` plus `"summary":
+//! {"recall_at_100_precision", "precision_at_100_recall", "max_f1"}` with ground truth.
+//! `candidates` holds, for every query with any hypothesis, its best match (higher score =
+//! more similar). Frame numbers are 0-based in input order (front-laser scans for CARMEN,
+//! frame numbers for KITTI). `ms_per_query` is the mean time to describe, query and insert a
+//! frame.
+
+mod input;
+mod truth;
+
+use std::path::PathBuf;
+
+use raypath_place_recognition::{
+    BinaryVocabulary, Candidate, Dbow, DbowConfig, Exclusion, FrameTiming, GlobalDescriptorDb,
+    GroundTruth, Ibuild, IbuildConfig, KidnappedRun, LoopClosure, LoopConfig, PlaceError,
+    PlaceRecognizer, PolarContext, PrSummary, ScanContext, Shot3dBow, VocabularyConfig,
+    detect_and_describe, detect_loops, frame_image, kidnapped_pr, online_pr, run_kidnapped,
+    run_online,
+};
+use serde_json::json;
+
+use self::input::{Input, read_input};
+use self::truth::{TruthParams, ground_truth};
+use super::Failure;
+
+/// Place-recognition methods.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Method {
+    /// IBuILD incremental binary bag of words (Khan 2017, §4.4).
+    Ibuild,
+    /// DBoW2-style bag of binary words over an offline vocabulary tree.
+    Dbow,
+    /// Scan Context (point clouds).
+    ScanContext,
+    /// HOG global descriptor, cosine similarity.
+    Hog,
+    /// GIST global descriptor, cosine similarity.
+    Gist,
+    /// SHOT 3-D bag of words (point clouds).
+    Shot,
+    /// Polar descriptor of planar scans.
+    Polar,
+}
+
+/// Evaluation settings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Mode {
+    /// Loop closure: incremental database, temporal consistency.
+    Online,
+    /// Kidnapped robot: full similarity matrix, no temporal consistency.
+    Kidnapped,
+}
+
+/// Arguments of `raypath loop-closure`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A CARMEN log, a KITTI sequence directory or a folder of PNG/JPEG images.
+    pub input: PathBuf,
+    /// The place-recognition method.
+    #[arg(long, value_enum, default_value_t = Method::Ibuild)]
+    pub method: Method,
+    /// Online loop closure or kidnapped-robot place recognition.
+    #[arg(long, value_enum, default_value_t = Mode::Online)]
+    pub mode: Mode,
+    /// Ground-truth poses: CARMEN (corrected) log, KITTI poses.txt or TUM file.
+    #[arg(long, value_name = "POSES")]
+    pub ground_truth: Option<PathBuf>,
+    /// DBoW vocabulary file (without it, dbow trains one on the input, with a warning).
+    #[arg(long, value_name = "FILE")]
+    pub vocabulary: Option<PathBuf>,
+    /// Write the DBoW vocabulary used (trained or read) to this file.
+    #[arg(long, value_name = "FILE")]
+    pub save_vocabulary: Option<PathBuf>,
+    /// IBuILD matching threshold δ, bits (default 80).
+    #[arg(long, value_name = "BITS")]
+    pub delta: Option<u32>,
+    /// Frames at least this far apart are compared and evaluated.
+    #[arg(long, default_value_t = 50, value_name = "N")]
+    pub exclusion_frames: usize,
+    /// Pairs closer in time than this are not evaluated, seconds (when frame times are known).
+    #[arg(long, default_value_t = 30.0, value_name = "S")]
+    pub exclusion_seconds: f64,
+    /// Temporal-consistency window β, frames (Khan 2017, §4.6.1).
+    #[arg(long, default_value_t = 10, value_name = "BETA")]
+    pub window: usize,
+    /// Accept only loops whose score is at least this.
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        value_name = "S",
+        allow_hyphen_values = true
+    )]
+    pub min_score: f64,
+    /// Switch the temporal-consistency test off (online mode).
+    #[arg(long)]
+    pub no_temporal_consistency: bool,
+    /// Ablation: accept an unconstrained loop only after this many consistent detections.
+    #[arg(long, default_value_t = 1, value_name = "K")]
+    pub consecutive: usize,
+    /// Same place: less than this many metres apart (default 2 for planar scans, 5 otherwise).
+    #[arg(long, value_name = "M")]
+    pub radius: Option<f64>,
+    /// Field of view of planar scans for the ground truth, degrees (default: the scan's span).
+    #[arg(long, value_name = "DEG")]
+    pub fov: Option<f64>,
+    /// Use only the first N frames.
+    #[arg(long, value_name = "N")]
+    pub max_frames: Option<usize>,
+    /// Kidnapped mode: keep this many best candidates per query (default all).
+    #[arg(long, value_name = "K")]
+    pub top_k: Option<usize>,
+    /// Print one JSON document on standard output.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// What a run produced.
+struct Outcome {
+    method: &'static str,
+    /// Per query, candidates sorted by score (the exclusion window applied).
+    candidates: Vec<Vec<Candidate>>,
+    timings: Vec<FrameTiming>,
+}
+
+fn loop_config(args: &Args) -> LoopConfig {
+    LoopConfig {
+        min_score: args.min_score,
+        temporal_window: args.window,
+        temporal_consistency: args.mode == Mode::Online && !args.no_temporal_consistency,
+        consecutive: args.consecutive,
+    }
+}
+
+fn check_args(args: &Args) -> Result<(), Failure> {
+    let bad = |m: &str| Err(Failure::input(m, args.json));
+    if !args.min_score.is_finite() {
+        return bad("--min-score: must be a finite number");
+    }
+    if !(args.exclusion_seconds.is_finite() && args.exclusion_seconds >= 0.0) {
+        return bad("--exclusion-seconds: must be finite and non-negative");
+    }
+    if args.radius.is_some_and(|r| !(r.is_finite() && r > 0.0)) {
+        return bad("--radius: must be positive");
+    }
+    if args.fov.is_some_and(|f| !(f.is_finite() && f > 0.0)) {
+        return bad("--fov: must be positive");
+    }
+    if args.top_k == Some(0) || args.max_frames == Some(0) {
+        return bad("--top-k and --max-frames must be at least 1");
+    }
+    if (args.vocabulary.is_some() || args.save_vocabulary.is_some()) && args.method != Method::Dbow
+    {
+        return bad("--vocabulary and --save-vocabulary apply to --method dbow only");
+    }
+    if args.delta.is_some() && args.method != Method::Ibuild {
+        return bad("--delta applies to --method ibuild only");
+    }
+    Ok(())
+}
+
+/// Runs `raypath loop-closure`.
+pub fn run(args: &Args) -> Result<(), Failure> {
+    check_args(args)?;
+    let input = read_input(&args.input, args.max_frames, args.json)?;
+    let truth = match &args.ground_truth {
+        None => None,
+        Some(path) => {
+            let params = TruthParams {
+                radius_m: args
+                    .radius
+                    .unwrap_or(if input.is_planar() { 2.0 } else { 5.0 }),
+                fov_rad: args.fov.map(f64::to_radians),
+                exclusion: Exclusion {
+                    frames: args.exclusion_frames,
+                    seconds: args.exclusion_seconds,
+                },
+            };
+            Some((path, ground_truth(path, &input, &params, args.json)?))
+        }
+    };
+    let outcome = dispatch(args, &input)?;
+    let config = loop_config(args);
+    let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()), args.json);
+    let loops = detect_loops(&config, &outcome.candidates).map_err(place)?;
+    let summary = match &truth {
+        None => None,
+        Some((_, gt)) => Some(evaluate(args, &config, &outcome, gt).map_err(place)?),
+    };
+    if args.json {
+        println!("{}", to_json(&input, &outcome, &loops, summary.as_ref()));
+    } else {
+        let truth_info = truth.as_ref().map(|(p, gt)| (p.as_path(), gt, summary));
+        print_text(args, &input, &outcome, &loops, truth_info);
+    }
+    Ok(())
+}
+
+fn evaluate(
+    args: &Args,
+    config: &LoopConfig,
+    outcome: &Outcome,
+    gt: &GroundTruth,
+) -> Result<PrSummary, PlaceError> {
+    let curve = match args.mode {
+        Mode::Online => online_pr(&outcome.candidates, gt, config, 200)?,
+        Mode::Kidnapped => kidnapped_pr(&outcome.candidates, gt)?,
+    };
+    Ok(curve.summary())
+}
+
+/// Builds the recognizer and runs it.
+fn dispatch(args: &Args, input: &Input) -> Result<Outcome, Failure> {
+    let json = args.json;
+    let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()), json);
+    match args.method {
+        Method::Ibuild => {
+            let config = IbuildConfig {
+                delta: args.delta.unwrap_or(IbuildConfig::default().delta),
+                beta: args.window.max(1),
+                ..IbuildConfig::default()
+            };
+            let r = Ibuild::new(config).map_err(place)?;
+            execute(r, args, input)
+        }
+        Method::Dbow => {
+            let config = DbowConfig::default();
+            let vocabulary = dbow_vocabulary(args, input, &config)?;
+            execute(Dbow::new(vocabulary, config), args, input)
+        }
+        Method::ScanContext => execute(
+            ScanContext::new(Default::default()).map_err(place)?,
+            args,
+            input,
+        ),
+        Method::Hog => execute(
+            GlobalDescriptorDb::hog(Default::default(), Default::default()),
+            args,
+            input,
+        ),
+        Method::Gist => execute(
+            GlobalDescriptorDb::gist(Default::default(), Default::default()).map_err(place)?,
+            args,
+            input,
+        ),
+        Method::Shot => execute(
+            Shot3dBow::new(Default::default()).map_err(place)?,
+            args,
+            input,
+        ),
+        Method::Polar => execute(
+            PolarContext::new(Default::default()).map_err(place)?,
+            args,
+            input,
+        ),
+    }
+}
+
+/// Runs a recognizer in the chosen mode.
+fn execute<R: PlaceRecognizer + Sync>(
+    mut recognizer: R,
+    args: &Args,
+    input: &Input,
+) -> Result<Outcome, Failure> {
+    let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()), args.json);
+    let n = input.len();
+    let source = |i| input.frame(i);
+    match args.mode {
+        Mode::Online => {
+            let run =
+                run_online(&mut recognizer, n, source, args.exclusion_frames).map_err(place)?;
+            Ok(Outcome {
+                method: run.method,
+                candidates: run.candidates,
+                timings: run.timings,
+            })
+        }
+        Mode::Kidnapped => {
+            let top_k = args.top_k.map(|k| k + 2 * args.exclusion_frames);
+            let run = run_kidnapped(&mut recognizer, n, source, top_k).map_err(place)?;
+            Ok(kidnapped_outcome(run, args.exclusion_frames, args.top_k))
+        }
+    }
+}
+
+/// Drops the frames closer than `exclusion` to each query (itself included) and keeps `top_k`.
+fn kidnapped_outcome(run: KidnappedRun, exclusion: usize, top_k: Option<usize>) -> Outcome {
+    let candidates = run
+        .candidates
+        .into_iter()
+        .enumerate()
+        .map(|(i, list)| {
+            let kept = list
+                .into_iter()
+                .filter(|c| c.frame.abs_diff(i) >= exclusion.max(1));
+            kept.take(top_k.unwrap_or(usize::MAX)).collect()
+        })
+        .collect();
+    Outcome {
+        method: run.method,
+        candidates,
+        timings: run.timings,
+    }
+}
+
+/// The DBoW vocabulary: read from `--vocabulary`, or trained on the input (with a warning).
+fn dbow_vocabulary(
+    args: &Args,
+    input: &Input,
+    config: &DbowConfig,
+) -> Result<BinaryVocabulary, Failure> {
+    let json = args.json;
+    let vocabulary = match &args.vocabulary {
+        Some(path) => {
+            let file = std::fs::File::open(path)
+                .map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))?;
+            BinaryVocabulary::from_reader(std::io::BufReader::new(file))
+                .map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))?
+        }
+        None => {
+            eprintln!(
+                "warning: no --vocabulary: training the DBoW vocabulary on the input itself; \
+                 this is not the offline protocol (a vocabulary from independent images) and \
+                 flatters DBoW"
+            );
+            let place =
+                |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()), json);
+            let mut images = Vec::with_capacity(input.len());
+            for i in 0..input.len() {
+                let frame = input.frame(i).map_err(place)?;
+                let image = frame_image(&frame.as_frame(), &config.image).map_err(place)?;
+                let (_, descriptors) = detect_and_describe(&image, &config.features)
+                    .map_err(|e| place(PlaceError::BadInput(format!("frame {i}: {e}"))))?;
+                images.push(descriptors);
+            }
+            BinaryVocabulary::train(&images, &VocabularyConfig::default(), 0).map_err(place)?
+        }
+    };
+    if let Some(path) = &args.save_vocabulary {
+        let write = || -> std::io::Result<()> {
+            let file = std::fs::File::create(path)?;
+            vocabulary.to_writer(std::io::BufWriter::new(file))
+        };
+        write().map_err(|e| Failure {
+            message: format!("{}: {e}", path.display()),
+            bad_input: false,
+            json,
+        })?;
+    }
+    Ok(vocabulary)
+}
+
+fn ms_per_query(outcome: &Outcome) -> f64 {
+    FrameTiming::mean(&outcome.timings).total_s * 1e3
+}
+
+fn to_json(
+    input: &Input,
+    outcome: &Outcome,
+    loops: &[LoopClosure],
+    summary: Option<&PrSummary>,
+) -> serde_json::Value {
+    let label = |i: usize| input.labels.get(i).copied().unwrap_or(i);
+    let loops: Vec<_> = loops
+        .iter()
+        .map(|l| json!({"query": label(l.query), "match": label(l.matched), "score": l.score}))
+        .collect();
+    let candidates: Vec<_> = outcome
+        .candidates
+        .iter()
+        .enumerate()
+        .filter_map(|(i, list)| {
+            let best = list.first()?;
+            Some(json!({"query": label(i), "match": label(best.frame), "score": best.score}))
+        })
+        .collect();
+    let mut doc = json!({
+        "method": outcome.method,
+        "frames": input.len(),
+        "ms_per_query": ms_per_query(outcome),
+        "loops": loops,
+        "candidates": candidates,
+    });
+    if let (Some(s), Some(obj)) = (summary, doc.as_object_mut()) {
+        obj.insert(
+            "summary".into(),
+            json!({
+                "recall_at_100_precision": s.recall_at_100_precision,
+                "precision_at_100_recall": s.precision_at_100_recall,
+                "max_f1": s.max_f1,
+            }),
+        );
+    }
+    doc
+}
+
+fn print_text(
+    args: &Args,
+    input: &Input,
+    outcome: &Outcome,
+    loops: &[LoopClosure],
+    truth: Option<(&std::path::Path, &GroundTruth, Option<PrSummary>)>,
+) {
+    let mean = FrameTiming::mean(&outcome.timings);
+    let mode = match args.mode {
+        Mode::Online => "online",
+        Mode::Kidnapped => "kidnapped",
+    };
+    println!(
+        "{}: {} {}, method {}, mode {mode}",
+        args.input.display(),
+        input.len(),
+        input.kind(),
+        outcome.method
+    );
+    println!(
+        "{:.2} ms per frame (describe {:.2}, query {:.2}, insert {:.2})",
+        mean.total_s * 1e3,
+        mean.describe_s * 1e3,
+        mean.query_s * 1e3,
+        mean.insert_s * 1e3
+    );
+    let with_candidates = outcome.candidates.iter().filter(|c| !c.is_empty()).count();
+    println!(
+        "{with_candidates} frames with candidates, {} accepted loop closures",
+        loops.len()
+    );
+    let label = |i: usize| input.labels.get(i).copied().unwrap_or(i);
+    for l in loops.iter().take(20) {
+        println!(
+            "  {} -> {} (score {:.4})",
+            label(l.query),
+            label(l.matched),
+            l.score
+        );
+    }
+    if loops.len() > 20 {
+        println!("  … {} more (--json lists all)", loops.len() - 20);
+    }
+    if let Some((path, gt, Some(s))) = truth {
+        println!(
+            "ground truth {}: {} true pairs; recall at 100% precision {:.4}, precision at 100% \
+             recall {:.4}, max F1 {:.4}",
+            path.display(),
+            gt.true_pairs(),
+            s.recall_at_100_precision,
+            s.precision_at_100_recall,
+            s.max_f1
+        );
+        if gt.true_pairs() == 0 {
+            println!("warning: the ground truth has no evaluable revisit; the summary is empty");
+        }
+    }
+}

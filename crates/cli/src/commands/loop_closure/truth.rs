@@ -1,0 +1,229 @@
+//! Ground truth of `raypath loop-closure`: poses from a CARMEN (corrected) log, a KITTI pose
+//! file (12 numbers a line) or a TUM file (`t x y z qx qy qz qw`), paired with the frames.
+//!
+//! Pairing: by index (by frame number for a KITTI sequence) when the file has no times (KITTI
+//! poses) or as many poses as the input has frames (CARMEN: front-laser scans); else by time —
+//! the pose at a frame's time, interpolated between the two ground-truth poses around it when
+//! they are at most [`MAX_GAP_SECS`] apart. Frames that get no pose are left out of the
+//! evaluation.
+
+use std::path::Path;
+
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use raypath_geometry::{Pose2, Pose3};
+use raypath_io::carmen::CarmenReader;
+use raypath_place_recognition::{Exclusion, GroundTruth};
+
+use super::super::Failure;
+use super::input::Input;
+
+/// Largest gap between two ground-truth poses that a frame's pose is interpolated over,
+/// seconds (ours).
+pub const MAX_GAP_SECS: f64 = 1.0;
+
+/// Largest distance between a frame time and a ground-truth time outside the ground truth's
+/// span that still pairs them (the corrected CARMEN logs print the stamps with fewer digits),
+/// seconds.
+const MATCH_TOLERANCE_SECS: f64 = 2e-3;
+
+/// Poses read from a ground-truth file.
+pub struct TruthPoses {
+    /// The poses, in file order.
+    pub poses: Vec<Pose3>,
+    /// Their times, when the file has them.
+    pub times: Option<Vec<f64>>,
+}
+
+/// How the ground truth is turned into revisits.
+pub struct TruthParams {
+    /// Radius of "the same place", metres.
+    pub radius_m: f64,
+    /// Field of view of a planar sensor, radians (`None`: the first scan's span).
+    pub fov_rad: Option<f64>,
+    /// The exclusion window.
+    pub exclusion: Exclusion,
+}
+
+/// Reads the ground-truth file and builds the revisits of the input's frames.
+pub fn ground_truth(
+    path: &Path,
+    input: &Input,
+    params: &TruthParams,
+    json: bool,
+) -> Result<GroundTruth, Failure> {
+    let truth = read_truth(path, json)?;
+    let paired = pair(&truth, input);
+    if paired.iter().all(Option::is_none) {
+        return Err(Failure::input(
+            format!(
+                "{}: no pose pairs with a frame of {} ({} poses, {} frames{})",
+                path.display(),
+                input.path.display(),
+                truth.poses.len(),
+                input.total,
+                if truth.times.is_some() && input.times.is_some() {
+                    ", no common times"
+                } else {
+                    ", and no times to pair them by"
+                }
+            ),
+            json,
+        ));
+    }
+    let times = input.times.as_deref();
+    let built = if input.is_planar() {
+        let poses: Vec<Pose2> = paired
+            .iter()
+            .map(|p| p.map_or(Pose2::new(f64::NAN, f64::NAN, 0.0), |p| p.to_planar()))
+            .collect();
+        let fov = params
+            .fov_rad
+            .or(input.scan_fov_rad())
+            .unwrap_or(std::f64::consts::TAU);
+        GroundTruth::from_planar_poses(&poses, times, params.radius_m, fov, params.exclusion)
+    } else {
+        let positions: Vec<[f64; 3]> = paired
+            .iter()
+            .map(|p| p.map_or([f64::NAN; 3], |p| p.translation().into()))
+            .collect();
+        GroundTruth::from_positions(&positions, times, params.radius_m, params.exclusion)
+    };
+    built.map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))
+}
+
+/// Reads a TUM or KITTI pose file, or else a CARMEN log (its front-laser poses and logger
+/// times).
+fn read_truth(path: &Path, json: bool) -> Result<TruthPoses, Failure> {
+    // Text pose files are plain UTF-8; CARMEN logs may be compressed.
+    if let Ok(text) = std::fs::read_to_string(path) {
+        let first = text
+            .lines()
+            .map(str::trim)
+            .enumerate()
+            .find(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+        let numbers = first.map(|(i, l)| {
+            let fields: Vec<&str> = l.split_whitespace().collect();
+            let numeric = fields.iter().all(|f| f.parse::<f64>().is_ok());
+            (numeric, fields.len(), i + 1)
+        });
+        match numbers {
+            Some((true, 12, _)) => {
+                let poses =
+                    raypath_io::kitti::read_poses(path).map_err(|e| Failure::input(e, json))?;
+                return Ok(TruthPoses { poses, times: None });
+            }
+            Some((true, 8, _)) => return read_tum(path, &text, json),
+            Some((true, n, line)) => {
+                return Err(Failure::input(
+                    format!(
+                        "{}: line {line}: {n} numbers; expected 12 (KITTI poses) or 8 (TUM \
+                         `t x y z qx qy qz qw`)",
+                        path.display()
+                    ),
+                    json,
+                ));
+            }
+            _ => {}
+        }
+    }
+    let reader = CarmenReader::open(path).map_err(|e| Failure::input(e, json))?;
+    let mut poses = Vec::new();
+    let mut times = Vec::new();
+    for m in reader.front_lasers() {
+        let m = m.map_err(|e| Failure::input(e, json))?;
+        poses.push(m.world_from_laser.to_pose3());
+        times.push(m.logger_timestamp_secs);
+    }
+    if poses.is_empty() {
+        return Err(Failure::input(
+            format!(
+                "{}: no poses (neither a CARMEN log with laser scans, KITTI poses nor a TUM file)",
+                path.display()
+            ),
+            json,
+        ));
+    }
+    Ok(TruthPoses {
+        poses,
+        times: Some(times),
+    })
+}
+
+/// Parses a TUM file `t x y z qx qy qz qw` (comments `#`).
+fn read_tum(path: &Path, text: &str, json: bool) -> Result<TruthPoses, Failure> {
+    let mut poses = Vec::new();
+    let mut times = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let bad = |reason: &str| {
+            Failure::input(
+                format!("{}: line {}: {reason}", path.display(), i + 1),
+                json,
+            )
+        };
+        let v: Vec<f64> = line
+            .split_whitespace()
+            .map(str::parse::<f64>)
+            .collect::<Result<_, _>>()
+            .map_err(|_| bad("expected 8 numbers `t x y z qx qy qz qw`"))?;
+        let [t, x, y, z, qx, qy, qz, qw] = v[..] else {
+            return Err(bad("expected 8 numbers `t x y z qx qy qz qw`"));
+        };
+        if v.iter().any(|c| !c.is_finite()) {
+            return Err(bad("non-finite number"));
+        }
+        let q = Quaternion::new(qw, qx, qy, qz);
+        if q.norm() < 1e-9 {
+            return Err(bad("zero quaternion"));
+        }
+        poses.push(Pose3::from_parts(
+            Vector3::new(x, y, z),
+            UnitQuaternion::from_quaternion(q),
+        ));
+        times.push(t);
+    }
+    Ok(TruthPoses {
+        poses,
+        times: Some(times),
+    })
+}
+
+/// The ground-truth pose of each frame (see the module documentation).
+fn pair(truth: &TruthPoses, input: &Input) -> Vec<Option<Pose3>> {
+    if truth.times.is_none() || truth.poses.len() == input.total {
+        let by_number = matches!(input.source, super::input::Source::Kitti(_));
+        return (0..input.len())
+            .map(|i| {
+                let k = if by_number { input.labels[i] } else { i };
+                truth.poses.get(k).copied()
+            })
+            .collect();
+    }
+    let (Some(truth_times), Some(frame_times)) = (&truth.times, &input.times) else {
+        return vec![None; input.len()];
+    };
+    let mut order: Vec<usize> = (0..truth_times.len()).collect();
+    order.sort_by(|&a, &b| truth_times[a].total_cmp(&truth_times[b]));
+    let sorted: Vec<f64> = order.iter().map(|&k| truth_times[k]).collect();
+    frame_times
+        .iter()
+        .map(|&t| {
+            let k = sorted.partition_point(|&s| s < t);
+            let near = |j: usize| (sorted[j] - t).abs() <= MATCH_TOLERANCE_SECS;
+            if k < sorted.len() && near(k) {
+                return Some(truth.poses[order[k]]);
+            }
+            if k > 0 && near(k - 1) {
+                return Some(truth.poses[order[k - 1]]);
+            }
+            if k == 0 || k == sorted.len() || sorted[k] - sorted[k - 1] > MAX_GAP_SECS {
+                return None;
+            }
+            let f = (t - sorted[k - 1]) / (sorted[k] - sorted[k - 1]);
+            Some(truth.poses[order[k - 1]].interpolate(&truth.poses[order[k]], f))
+        })
+        .collect()
+}
