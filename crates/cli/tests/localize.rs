@@ -244,7 +244,7 @@ fn bad_input_exits_2_naming_the_file_and_place() {
             "--ground-truth",
             s(&bad_gt),
         ],
-        &["bad.tum", "line 3"],
+        &["bad.tum:3"],
     );
     // Bad parameters.
     expect_input_error(

@@ -50,6 +50,7 @@ pub mod pcd;
 pub mod point_csv;
 pub mod segcomp;
 pub mod source;
+pub mod tum;
 pub mod xyz;
 
 pub use detect::{Format, summarize, summarize_as};

@@ -94,36 +94,14 @@ fn read_log(path: &Path, json: bool) -> Result<Vec<LogScan>, Failure> {
         .collect()
 }
 
-/// Reads a TUM file `t x y z qx qy qz qw` (comments `#`), keeping x, y and the yaw.
+/// Reads a TUM file `t x y z qx qy qz qw` (through `raypath_io::tum`), keeping x, y and the
+/// yaw.
 fn read_tum(path: &Path, json: bool) -> Result<Vec<(f64, Pose2)>, Failure> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))?;
-    let mut out = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let bad = |reason: &str| {
-            Failure::input(
-                format!("{}: line {}: {reason}", path.display(), i + 1),
-                json,
-            )
-        };
-        let v: Vec<f64> = line
-            .split_whitespace()
-            .map(str::parse::<f64>)
-            .collect::<Result<_, _>>()
-            .map_err(|_| bad("expected 8 numbers `t x y z qx qy qz qw`"))?;
-        let [t, x, y, _z, qx, qy, qz, qw] = v[..] else {
-            return Err(bad("expected 8 numbers `t x y z qx qy qz qw`"));
-        };
-        if v.iter().any(|c| !c.is_finite()) {
-            return Err(bad("non-finite number"));
-        }
-        let yaw = (2.0 * (qw * qz + qx * qy)).atan2(1.0 - 2.0 * (qy * qy + qz * qz));
-        out.push((t, Pose2::new(x, y, yaw)));
-    }
+    let out: Vec<(f64, Pose2)> = raypath_io::tum::read_tum(path)
+        .map_err(|e| Failure::input(e, json))?
+        .into_iter()
+        .map(|p| (p.time_s, p.pose.to_planar()))
+        .collect();
     if out.is_empty() {
         return Err(Failure::input(
             format!(

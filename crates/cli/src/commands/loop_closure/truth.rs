@@ -9,7 +9,6 @@
 
 use std::path::Path;
 
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use raypath_geometry::{Pose2, Pose3};
 use raypath_io::carmen::CarmenReader;
 use raypath_place_recognition::{Exclusion, GroundTruth};
@@ -112,7 +111,7 @@ fn read_truth(path: &Path, json: bool) -> Result<TruthPoses, Failure> {
                     raypath_io::kitti::read_poses(path).map_err(|e| Failure::input(e, json))?;
                 return Ok(TruthPoses { poses, times: None });
             }
-            Some((true, 8, _)) => return read_tum(path, &text, json),
+            Some((true, 8, _)) => return read_tum(path, json),
             Some((true, n, line)) => {
                 return Err(Failure::input(
                     format!(
@@ -149,45 +148,12 @@ fn read_truth(path: &Path, json: bool) -> Result<TruthPoses, Failure> {
     })
 }
 
-/// Parses a TUM file `t x y z qx qy qz qw` (comments `#`).
-fn read_tum(path: &Path, text: &str, json: bool) -> Result<TruthPoses, Failure> {
-    let mut poses = Vec::new();
-    let mut times = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let bad = |reason: &str| {
-            Failure::input(
-                format!("{}: line {}: {reason}", path.display(), i + 1),
-                json,
-            )
-        };
-        let v: Vec<f64> = line
-            .split_whitespace()
-            .map(str::parse::<f64>)
-            .collect::<Result<_, _>>()
-            .map_err(|_| bad("expected 8 numbers `t x y z qx qy qz qw`"))?;
-        let [t, x, y, z, qx, qy, qz, qw] = v[..] else {
-            return Err(bad("expected 8 numbers `t x y z qx qy qz qw`"));
-        };
-        if v.iter().any(|c| !c.is_finite()) {
-            return Err(bad("non-finite number"));
-        }
-        let q = Quaternion::new(qw, qx, qy, qz);
-        if q.norm() < 1e-9 {
-            return Err(bad("zero quaternion"));
-        }
-        poses.push(Pose3::from_parts(
-            Vector3::new(x, y, z),
-            UnitQuaternion::from_quaternion(q),
-        ));
-        times.push(t);
-    }
+/// Reads a TUM file `t x y z qx qy qz qw` through `raypath_io::tum`.
+fn read_tum(path: &Path, json: bool) -> Result<TruthPoses, Failure> {
+    let stamped = raypath_io::tum::read_tum(path).map_err(|e| Failure::input(e, json))?;
     Ok(TruthPoses {
-        poses,
-        times: Some(times),
+        poses: stamped.iter().map(|p| p.pose).collect(),
+        times: Some(stamped.iter().map(|p| p.time_s).collect()),
     })
 }
 
