@@ -168,7 +168,7 @@ pub use rectilinear::{RectilinearConfig, cubic_front_back, rectilinear};
 
 // --- ibuild (IBuILD work) ---
 pub use ibuild::{
-    Ibuild, IbuildConfig, IbuildDescription, MultiIndexLayout, StageTimes, Vocabulary,
+    Ibuild, IbuildConfig, IbuildDescription, IbuildScore, MultiIndexLayout, StageTimes, Vocabulary,
     VocabularySearch, WordIndex, match_consecutive, merge_descriptors,
 };
 // --- end ibuild ---

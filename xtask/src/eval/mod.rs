@@ -11,6 +11,7 @@ mod geometry;
 mod io;
 mod mcl;
 mod octomap;
+mod place_recognition;
 mod poles_kitti;
 mod poles_nclt;
 mod polylines;
@@ -151,6 +152,11 @@ const EVALUATIONS: &[(&str, &str, EvalFn)] = &[
         "scan-matching",
         "intensity calibration and Hector-style scan matching with occupancy/reflectivity residuals (Khan ch. 3)",
         scan_matching::run,
+    ),
+    (
+        "place-recognition",
+        "IBuILD loop closure and lidar place recognition beside DBoW2, Scan Context, HOG, GIST, SHOT (Khan ch. 4)",
+        place_recognition::run,
     ),
 ];
 

@@ -41,8 +41,8 @@ use std::path::PathBuf;
 
 use raypath_place_recognition::{
     BinaryVocabulary, Candidate, Dbow, DbowConfig, Exclusion, FrameTiming, GlobalDescriptorDb,
-    GroundTruth, Ibuild, IbuildConfig, KidnappedRun, LoopClosure, LoopConfig, PlaceError,
-    PlaceRecognizer, PolarContext, PrSummary, ScanContext, Shot3dBow, VocabularyConfig,
+    GroundTruth, Ibuild, IbuildConfig, IbuildScore, KidnappedRun, LoopClosure, LoopConfig,
+    PlaceError, PlaceRecognizer, PolarContext, PrSummary, ScanContext, Shot3dBow, VocabularyConfig,
     detect_and_describe, detect_loops, frame_image, kidnapped_pr, online_pr, run_kidnapped,
     run_online,
 };
@@ -103,6 +103,10 @@ pub struct Args {
     /// IBuILD matching threshold δ, bits (default 80).
     #[arg(long, value_name = "BITS")]
     pub delta: Option<u32>,
+    /// IBuILD similarity: the thesis' normalised modified Jaccard index (`printed`) or our
+    /// symmetric, unnormalised variant (`symmetric`).
+    #[arg(long, value_enum, default_value_t = IbuildScoreArg::Printed)]
+    pub ibuild_score: IbuildScoreArg,
     /// Frames at least this far apart are compared and evaluated.
     #[arg(long, default_value_t = 50, value_name = "N")]
     pub exclusion_frames: usize,
@@ -237,6 +241,15 @@ fn evaluate(
     Ok(curve.summary())
 }
 
+/// `--ibuild-score` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum IbuildScoreArg {
+    /// Khan 2017, §4.4.3 as printed, normalised over the hypotheses.
+    Printed,
+    /// Ours: symmetric in the query's and the hypothesis' missing words, not normalised.
+    Symmetric,
+}
+
 /// Builds the recognizer and runs it.
 fn dispatch(args: &Args, input: &Input) -> Result<Outcome, Failure> {
     let json = args.json;
@@ -246,6 +259,10 @@ fn dispatch(args: &Args, input: &Input) -> Result<Outcome, Failure> {
             let config = IbuildConfig {
                 delta: args.delta.unwrap_or(IbuildConfig::default().delta),
                 beta: args.window.max(1),
+                score: match args.ibuild_score {
+                    IbuildScoreArg::Printed => IbuildScore::Printed,
+                    IbuildScoreArg::Symmetric => IbuildScore::Symmetric,
+                },
                 ..IbuildConfig::default()
             };
             let r = Ibuild::new(config).map_err(place)?;

@@ -30,6 +30,8 @@ pub struct IbuildConfig {
     /// Eq. (4.1) with ties going to 0 (a pair's centroid is then the AND) instead of 1 (the OR,
     /// as printed). Ablation, default false.
     pub strict_majority: bool,
+    /// The similarity score of the candidates (default [`IbuildScore::Printed`], §4.4.3).
+    pub score: IbuildScore,
     /// First-match search engine (identical answers; default [`VocabularySearch::Auto`]:
     /// multi-index hashing where it is expected to be faster than the scan).
     pub search: VocabularySearch,
@@ -46,9 +48,26 @@ impl Default for IbuildConfig {
             merge_until_fixed_point: false,
             recentroid_matched: false,
             strict_majority: false,
+            score: IbuildScore::Printed,
             search: VocabularySearch::default(),
         }
     }
+}
+
+/// Which similarity IBuILD reports for its hypotheses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum IbuildScore {
+    /// The modified Jaccard index as printed, normalised over the hypotheses
+    /// (`Ŝ = S / Σ_L S`, §4.4.3). Its denominator counts the hypothesis' words missing from
+    /// the query (`T`) but not the query's old words missing from the hypothesis, so an image
+    /// whose words are a subset of the query's scores `S = 1`; and `Ŝ` depends on how many
+    /// hypotheses a query has, so one threshold means different things for different queries.
+    #[default]
+    Printed,
+    /// Ours: the same index made symmetric — the query's old words missing from the
+    /// hypothesis enter the denominator like `T` (`Σ_{q∈Q} f_q⁻¹ |Q|`) — and not normalised,
+    /// so scores are comparable across queries (a score threshold is then meaningful).
+    Symmetric,
 }
 
 impl IbuildConfig {

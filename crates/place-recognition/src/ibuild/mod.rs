@@ -76,7 +76,7 @@ mod tests;
 use std::borrow::Cow;
 use std::time::Instant;
 
-pub use config::IbuildConfig;
+pub use config::{IbuildConfig, IbuildScore};
 pub use matching::{match_consecutive, merge_descriptors};
 pub use multi_index::MultiIndexLayout;
 pub use search::{VocabularySearch, WordIndex};
@@ -217,7 +217,7 @@ impl PlaceRecognizer for Ibuild {
         old.sort_unstable();
         old.dedup();
         let n_new = assignment.iter().filter(|a| a.is_none()).count();
-        let out = similarity::hypotheses(&self.vocabulary, &old, n_new, before);
+        let out = similarity::hypotheses(&self.vocabulary, &old, n_new, before, self.config.score);
         self.clock.lap(Stage::Hypotheses, start);
         self.clock.count(1);
         out
@@ -226,7 +226,7 @@ impl PlaceRecognizer for Ibuild {
     fn query_stored(&self, index: usize, before: usize) -> Vec<Candidate> {
         let start = Instant::now();
         let old = self.vocabulary.words_of(index);
-        let out = similarity::hypotheses(&self.vocabulary, old, 0, before);
+        let out = similarity::hypotheses(&self.vocabulary, old, 0, before, self.config.score);
         self.clock.lap(Stage::Hypotheses, start);
         self.clock.count(1);
         out

@@ -14,6 +14,7 @@
 //! No candidate is proposed from a single hypothesis: `|L| ≤ 1` gives none. There is no
 //! threshold on `Ŝ` (the thesis traces its precision–recall points by varying δ).
 
+use super::config::IbuildScore;
 use super::vocabulary::Vocabulary;
 use crate::Candidate;
 
@@ -24,6 +25,7 @@ pub(crate) fn hypotheses(
     old: &[u32],
     n_new: usize,
     before: usize,
+    mode: IbuildScore,
 ) -> Vec<Candidate> {
     let limit = before.min(vocabulary.num_images());
     if limit < 2 {
@@ -53,6 +55,12 @@ pub(crate) fn hypotheses(
     }
     touched.sort_unstable();
     let n_new = n_new as f64;
+    // Σ 1/f over the query's old words (for the symmetric score's Q = old \ U).
+    let query_sum: f64 = old
+        .iter()
+        .filter_map(|&m| vocabulary.frequencies().get(m as usize))
+        .map(|&f| 1.0 / f64::from(f.max(1)))
+        .sum();
     let mut out: Vec<Candidate> = touched
         .iter()
         .map(|&image| {
@@ -64,16 +72,23 @@ pub(crate) fn hypotheses(
                 0.0
             };
             let u = u_sum * f64::from(u_count);
-            let score = u / (u + t_sum * t_count + n_new); // §4.4.3, S(I_i, I_t)
+            let mut denominator = u + t_sum * t_count + n_new; // §4.4.3, S(I_i, I_t)
+            if mode == IbuildScore::Symmetric {
+                let q_count = old.len() as f64 - f64::from(u_count);
+                denominator += (query_sum - u_sum).max(0.0) * q_count;
+            }
+            let score = u / denominator;
             Candidate {
                 frame: image as usize,
                 score,
             }
         })
         .collect();
-    let total: f64 = out.iter().map(|c| c.score).sum();
-    for c in &mut out {
-        c.score /= total; // Ŝ = S / Σ_L S
+    if mode == IbuildScore::Printed {
+        let total: f64 = out.iter().map(|c| c.score).sum();
+        for c in &mut out {
+            c.score /= total; // Ŝ = S / Σ_L S
+        }
     }
     out
 }

@@ -129,6 +129,39 @@ fn similarity_is_the_modified_jaccard_index_as_printed() {
 }
 
 #[test]
+fn symmetric_score_penalises_subsets_and_is_not_normalised() {
+    let w = words();
+    let mut m = Ibuild::new(IbuildConfig {
+        score: IbuildScore::Symmetric,
+        ..IbuildConfig::default()
+    })
+    .unwrap();
+    m.insert(IbuildDescription::from_words(vec![w.a, w.b, w.c, w.h]));
+    m.insert(IbuildDescription::from_words(vec![w.a, w.d]));
+    m.insert(IbuildDescription::from_words(vec![w.b, w.e]));
+    // Query {A, B, F, G} as above: old A, B (f = 2), N_new = 2.
+    let d = IbuildDescription::from_words(vec![w.a, w.b, w.f, w.g]);
+    let c = m.query(&d, 3);
+    // I_0: Q = ∅, so S = 2/(2 + 4 + 2) = 1/4 unchanged.
+    // I_1: U = {A}: 1/2; T = {D}: 1; Q = {B}: 1/2·1 → S = 0.5/(0.5 + 1 + 0.5 + 2) = 1/8.
+    let s = [0.25, 0.125, 0.125];
+    for (k, cand) in c.iter().enumerate() {
+        assert!((cand.score - s[k]).abs() < 1e-12, "{cand:?}");
+    }
+    // Kidnapped: image 1 ({A, D}) against itself scores 1; the printed score gives image 0's
+    // superset the same kind of tie for a subset query, the symmetric one does not.
+    let stored = m.query_stored(1, 3);
+    let own = stored.iter().find(|c| c.frame == 1).unwrap();
+    assert!((own.score - 1.0).abs() < 1e-12);
+    assert!(
+        stored
+            .iter()
+            .filter(|c| c.frame != 1)
+            .all(|c| c.score < 1.0)
+    );
+}
+
+#[test]
 fn no_candidate_from_a_single_hypothesis() {
     let (m, w) = three_images(VocabularySearch::MultiIndex);
     let d = IbuildDescription::from_words(vec![w.a, w.b, w.f]);
