@@ -17,30 +17,18 @@ use criterion::{BenchmarkId, Criterion, SamplingMode, Throughput, criterion_main
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use raypath_place_recognition::{BinaryDescriptor, Bits512, VocabularySearch, WordIndex};
+use raypath_place_recognition::{Bits512, VocabularySearch, WordIndex};
 
 const SIZES: [usize; 3] = [10_000, 100_000, 1_000_000];
 const DELTAS: [u32; 3] = [40, 80, 120];
 const QUERIES: usize = 64;
 
-fn random_word(rng: &mut ChaCha8Rng) -> Bits512 {
-    BinaryDescriptor(std::array::from_fn(|_| rng.random()))
-}
-
-fn flip(mut w: Bits512, n: usize, rng: &mut ChaCha8Rng) -> Bits512 {
-    for _ in 0..n {
-        let i = rng.random_range(0..512);
-        w.set_bit(i, !w.bit(i));
-    }
-    w
-}
-
 fn vocabulary(n: usize, rng: &mut ChaCha8Rng) -> Vec<Bits512> {
-    let mut words: Vec<Bits512> = (0..n / 2).map(|_| random_word(rng)).collect();
+    let mut words: Vec<Bits512> = (0..n / 2).map(|_| Bits512::random(rng)).collect();
     while words.len() < n {
-        let centre = random_word(rng);
+        let centre = Bits512::random(rng);
         for _ in 0..8.min(n - words.len()) {
-            words.push(flip(centre, 48, rng));
+            words.push(centre.with_flipped_bits(48, rng));
         }
     }
     words.shuffle(rng);
@@ -52,9 +40,9 @@ fn queries(words: &[Bits512], delta: u32, rng: &mut ChaCha8Rng) -> Vec<Bits512> 
         .map(|k| {
             if k % 2 == 0 {
                 let w = words[rng.random_range(0..words.len())];
-                flip(w, delta as usize / 2, rng)
+                w.with_flipped_bits(delta as usize / 2, rng)
             } else {
-                random_word(rng)
+                Bits512::random(rng)
             }
         })
         .collect()

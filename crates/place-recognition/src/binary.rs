@@ -89,6 +89,21 @@ impl<const W: usize> BinaryDescriptor<W> {
         Some(out)
     }
 
+    /// A uniformly random descriptor (for tests, benchmarks and synthetic vocabularies).
+    pub fn random(rng: &mut impl rand::Rng) -> Self {
+        Self(std::array::from_fn(|_| rng.random()))
+    }
+
+    /// A copy with `n` randomly chosen bits flipped (the same bit may be drawn twice, so the
+    /// Hamming distance to `self` is at most `n`).
+    pub fn with_flipped_bits(mut self, n: usize, rng: &mut impl rand::Rng) -> Self {
+        for _ in 0..n {
+            let i = rng.random_range(0..Self::BITS);
+            self.set_bit(i, !self.bit(i));
+        }
+        self
+    }
+
     /// The centroid of a pair, eq. (4.1) with k = 2: the bitwise OR.
     #[inline]
     pub fn pair_centroid(&self, other: &Self) -> Self {

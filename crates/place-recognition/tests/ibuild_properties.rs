@@ -6,21 +6,8 @@ use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use raypath_place_recognition::{
-    BinaryDescriptor, Bits512, Candidate, Ibuild, IbuildConfig, PlaceRecognizer, VocabularySearch,
-    WordIndex,
+    Bits512, Candidate, Ibuild, IbuildConfig, PlaceRecognizer, VocabularySearch, WordIndex,
 };
-
-fn random_word(rng: &mut ChaCha8Rng) -> Bits512 {
-    BinaryDescriptor(std::array::from_fn(|_| rng.random()))
-}
-
-fn flip(mut w: Bits512, n: usize, rng: &mut ChaCha8Rng) -> Bits512 {
-    for _ in 0..n {
-        let i = rng.random_range(0..512);
-        w.set_bit(i, !w.bit(i));
-    }
-    w
-}
 
 /// Fig. 4.9 written plainly: the first index within δ.
 fn first_match(words: &[Bits512], q: &Bits512, delta: u32) -> Option<u32> {
@@ -33,14 +20,10 @@ fn first_match(words: &[Bits512], q: &Bits512, delta: u32) -> Option<u32> {
 /// A word: fresh random, or a near-duplicate of an earlier one (`H` around δ, both sides).
 fn next_word(words: &[Bits512], delta: u32, rng: &mut ChaCha8Rng) -> Bits512 {
     if words.is_empty() || rng.random_bool(0.3) {
-        random_word(rng)
+        Bits512::random(rng)
     } else {
         let base = words[rng.random_range(0..words.len())];
-        flip(
-            base,
-            rng.random_range(0..=(delta as usize * 3 / 2 + 2)),
-            rng,
-        )
+        base.with_flipped_bits(rng.random_range(0..=(delta as usize * 3 / 2 + 2)), rng)
     }
 }
 
@@ -80,15 +63,18 @@ proptest! {
 fn frames(seed: u64) -> Vec<Vec<Bits512>> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let places: Vec<Vec<Bits512>> = (0..6)
-        .map(|_| (0..25).map(|_| random_word(&mut rng)).collect())
+        .map(|_| (0..25).map(|_| Bits512::random(&mut rng)).collect())
         .collect();
     let mut out = Vec::new();
     for _ in 0..40 {
         let p = &places[rng.random_range(0..places.len())];
         for _ in 0..rng.random_range(1..4) {
             let noise = rng.random_range(0..30);
-            let mut f: Vec<Bits512> = p.iter().map(|w| flip(*w, noise, &mut rng)).collect();
-            f.extend((0..rng.random_range(0..6)).map(|_| random_word(&mut rng)));
+            let mut f: Vec<Bits512> = p
+                .iter()
+                .map(|w| w.with_flipped_bits(noise, &mut rng))
+                .collect();
+            f.extend((0..rng.random_range(0..6)).map(|_| Bits512::random(&mut rng)));
             out.push(f);
         }
     }

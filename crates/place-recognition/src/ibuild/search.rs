@@ -196,19 +196,6 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::*;
-    use crate::BinaryDescriptor;
-
-    fn random_word(rng: &mut ChaCha8Rng) -> Bits512 {
-        BinaryDescriptor(std::array::from_fn(|_| rng.random()))
-    }
-
-    fn flip(mut w: Bits512, n: usize, rng: &mut ChaCha8Rng) -> Bits512 {
-        for _ in 0..n {
-            let i = rng.random_range(0..512);
-            w.set_bit(i, !w.bit(i));
-        }
-        w
-    }
 
     /// Reference: Fig. 4.9 written plainly.
     fn reference(words: &[Bits512], q: &Bits512, delta: u32) -> Option<u32> {
@@ -221,18 +208,18 @@ mod tests {
     #[test]
     fn engines_return_the_first_match_not_the_nearest() {
         let mut rng = ChaCha8Rng::seed_from_u64(7);
-        let q = random_word(&mut rng);
+        let q = Bits512::random(&mut rng);
         for search in [
             VocabularySearch::Linear,
             VocabularySearch::MultiIndex,
             VocabularySearch::Auto,
         ] {
             let mut index = WordIndex::new(60, search).unwrap();
-            index.push(random_word(&mut rng));
-            index.push(flip(q, 50, &mut rng)); // within δ, farther
+            index.push(Bits512::random(&mut rng));
+            index.push(q.with_flipped_bits(50, &mut rng)); // within δ, farther
             index.push(q); // nearest
             assert_eq!(index.first_match(&q), Some(1), "{search:?}");
-            assert_eq!(index.first_match(&random_word(&mut rng)), None);
+            assert_eq!(index.first_match(&Bits512::random(&mut rng)), None);
         }
     }
 
@@ -242,28 +229,22 @@ mod tests {
         for delta in [1, 5, 17, 40, 64, 80, 121] {
             let mut lin = WordIndex::new(delta, VocabularySearch::Linear).unwrap();
             let mut mih = WordIndex::new(delta, VocabularySearch::MultiIndex).unwrap();
-            let base: Vec<Bits512> = (0..20).map(|_| random_word(&mut rng)).collect();
+            let base: Vec<Bits512> = (0..20).map(|_| Bits512::random(&mut rng)).collect();
             for i in 0..300 {
-                let w = flip(
-                    base[i % 20],
-                    rng.random_range(0..2 * delta as usize),
-                    &mut rng,
-                );
+                let w = base[i % 20]
+                    .with_flipped_bits(rng.random_range(0..2 * delta as usize), &mut rng);
                 lin.push(w);
                 mih.push(w);
                 if i % 7 == 3 {
                     let id = rng.random_range(0..=i as u32);
-                    let new = flip(w, 30, &mut rng);
+                    let new = w.with_flipped_bits(30, &mut rng);
                     lin.replace(id, new);
                     mih.replace(id, new);
                 }
             }
             for _ in 0..200 {
-                let q = flip(
-                    base[rng.random_range(0..20)],
-                    rng.random_range(0..2 * delta as usize),
-                    &mut rng,
-                );
+                let q = base[rng.random_range(0..20)]
+                    .with_flipped_bits(rng.random_range(0..2 * delta as usize), &mut rng);
                 let want = reference(lin.words(), &q, delta);
                 assert_eq!(lin.first_match(&q), want, "linear, delta {delta}");
                 assert_eq!(mih.first_match(&q), want, "multi-index, delta {delta}");

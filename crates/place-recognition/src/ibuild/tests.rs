@@ -1,22 +1,9 @@
 //! Unit tests of the IBuILD pipeline on hand-made descriptors.
 
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use super::*;
-use crate::BinaryDescriptor;
-
-fn random_word(rng: &mut ChaCha8Rng) -> Bits512 {
-    BinaryDescriptor(std::array::from_fn(|_| rng.random()))
-}
-
-fn flip(mut w: Bits512, n: usize, rng: &mut ChaCha8Rng) -> Bits512 {
-    for _ in 0..n {
-        let i = rng.random_range(0..512);
-        w.set_bit(i, !w.bit(i));
-    }
-    w
-}
 
 fn ibuild(search: VocabularySearch) -> Ibuild {
     Ibuild::new(IbuildConfig {
@@ -40,7 +27,7 @@ struct Words {
 
 fn words() -> Words {
     let mut rng = ChaCha8Rng::seed_from_u64(3);
-    let mut w = || random_word(&mut rng);
+    let mut w = || Bits512::random(&mut rng);
     Words {
         a: w(),
         b: w(),
@@ -199,13 +186,16 @@ fn cached_assignment_is_refreshed_after_an_update() {
 fn sequence(places: usize, per_place: usize, seed: u64) -> Vec<Vec<Bits512>> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let pools: Vec<Vec<Bits512>> = (0..places)
-        .map(|_| (0..30).map(|_| random_word(&mut rng)).collect())
+        .map(|_| (0..30).map(|_| Bits512::random(&mut rng)).collect())
         .collect();
     let mut frames = Vec::new();
     for pool in &pools {
         for _ in 0..per_place {
-            let mut f: Vec<Bits512> = pool.iter().map(|w| flip(*w, 10, &mut rng)).collect();
-            f.extend((0..5).map(|_| random_word(&mut rng)));
+            let mut f: Vec<Bits512> = pool
+                .iter()
+                .map(|w| w.with_flipped_bits(10, &mut rng))
+                .collect();
+            f.extend((0..5).map(|_| Bits512::random(&mut rng)));
             frames.push(f);
         }
     }
