@@ -141,21 +141,13 @@ pub fn run_online<R: PlaceRecognizer>(
     let mut candidates = Vec::with_capacity(n_frames);
     let mut timings = Vec::with_capacity(n_frames);
     for t in 0..n_frames {
-        let frame = frame_source(t)?;
-        let start = Instant::now();
-        let description = recognizer
-            .describe(&frame.as_frame())
-            .map_err(|e| at_frame(t, e))?;
-        let describe_s = seconds_since(start);
-        let start = Instant::now();
-        let mut found = recognizer.query(&description, t.saturating_sub(exclusion_frames));
-        let query_s = seconds_since(start);
-        let start = Instant::now();
-        recognizer.insert(description);
-        let insert_s = seconds_since(start);
+        let mut found = Vec::new();
+        let timing = step(recognizer, t, &mut frame_source, |r, d| {
+            found = r.query(d, t.saturating_sub(exclusion_frames));
+        })?;
         sort_candidates(&mut found);
         candidates.push(found);
-        timings.push(FrameTiming::new(describe_s, query_s, insert_s));
+        timings.push(timing);
     }
     Ok(OnlineRun {
         method: recognizer.name(),
@@ -173,17 +165,30 @@ fn build_database<R: PlaceRecognizer>(
     require_empty(recognizer)?;
     let mut timings = Vec::with_capacity(n_frames);
     for t in 0..n_frames {
-        let frame = frame_source(t)?;
-        let start = Instant::now();
-        let description = recognizer
-            .describe(&frame.as_frame())
-            .map_err(|e| at_frame(t, e))?;
-        let describe_s = seconds_since(start);
-        let start = Instant::now();
-        recognizer.insert(description);
-        timings.push(FrameTiming::new(describe_s, 0.0, seconds_since(start)));
+        timings.push(step(recognizer, t, frame_source, |_, _| {})?);
     }
     Ok(timings)
+}
+
+/// One frame of a run: describe frame `t`, call `query` on the description (timed), insert it.
+fn step<R: PlaceRecognizer>(
+    recognizer: &mut R,
+    t: usize,
+    frame_source: &mut impl FnMut(usize) -> Result<OwnedFrame>,
+    query: impl FnOnce(&R, &R::Description),
+) -> Result<FrameTiming> {
+    let frame = frame_source(t)?;
+    let start = Instant::now();
+    let description = recognizer
+        .describe(&frame.as_frame())
+        .map_err(|e| at_frame(t, e))?;
+    let describe_s = seconds_since(start);
+    let start = Instant::now();
+    query(recognizer, &description);
+    let query_s = seconds_since(start);
+    let start = Instant::now();
+    recognizer.insert(description);
+    Ok(FrameTiming::new(describe_s, query_s, seconds_since(start)))
 }
 
 /// Queries stored frame `i` against all `n` frames: sorted, truncated candidates and the time.
