@@ -53,11 +53,14 @@ pub enum Format {
     SegcompGtAng,
     /// CSV of points with a header row (`x,y[,z][,…]`), such as pole maps.
     PointCsv,
+    /// A rosbag2 recording with MCAP storage: its directory (with `metadata.yaml`) or its
+    /// `.mcap` file.
+    Rosbag2,
 }
 
 impl Format {
     /// Every format, in documentation order.
-    pub const ALL: [Format; 20] = [
+    pub const ALL: [Format; 21] = [
         Format::Carmen,
         Format::Pcd,
         Format::Xyz,
@@ -78,6 +81,7 @@ impl Format {
         Format::SegcompGtSeg,
         Format::SegcompGtAng,
         Format::PointCsv,
+        Format::Rosbag2,
     ];
 
     /// The format with this [`Format::name`].
@@ -108,6 +112,7 @@ impl Format {
             Format::SegcompGtSeg => "segcomp-gt-seg",
             Format::SegcompGtAng => "segcomp-gt-ang",
             Format::PointCsv => "point-csv",
+            Format::Rosbag2 => "rosbag2",
         }
     }
 
@@ -116,6 +121,9 @@ impl Format {
     pub fn detect(path: &Path) -> Result<Format> {
         let meta =
             std::fs::metadata(path).map_err(|e| Error::io(path, crate::Location::File, e))?;
+        if crate::rosbag::is_bag(path)? {
+            return Ok(Format::Rosbag2);
+        }
         if meta.is_dir() {
             return detect_dir(path);
         }
@@ -239,7 +247,57 @@ pub fn summarize_as(path: &Path, format: Format) -> Result<Summary> {
             segcomp::summarize(path, format)
         }
         Format::PointCsv => point_csv::summarize(path),
+        Format::Rosbag2 => bag_summary(path),
     }
+}
+
+/// A bag's summary: LaserScan and PointCloud2 messages as scans, PoseStamped as poses,
+/// Odometry as odometry, the log-time span, and per topic its type, count and rate under
+/// `topics` (with `profile`, `storage`, `compression`, `indexed`, `file_size_bytes`,
+/// `warnings`).
+fn bag_summary(path: &Path) -> Result<Summary> {
+    let info = crate::rosbag::info(path)?;
+    let count = |types: &[&str]| -> Option<u64> {
+        let n: u64 = info
+            .topics
+            .iter()
+            .filter(|t| types.contains(&t.type_name.as_str()))
+            .map(|t| t.message_count)
+            .sum();
+        (n > 0).then_some(n)
+    };
+    let mut summary = Summary {
+        format: Format::Rosbag2.name().into(),
+        scans: count(&["sensor_msgs/msg/LaserScan", "sensor_msgs/msg/PointCloud2"]),
+        poses: count(&["geometry_msgs/msg/PoseStamped"]),
+        odometry: count(&["nav_msgs/msg/Odometry"]),
+        time_span: match (info.start_secs, info.end_secs) {
+            (Some(start), Some(end)) => Some(crate::TimeSpan {
+                start,
+                end,
+                duration: end - start,
+            }),
+            _ => None,
+        },
+        ..Summary::default()
+    };
+    let mut put = |key: &str, value: serde_json::Value| {
+        summary.extra.insert(key.into(), value);
+    };
+    put("profile", info.profile.clone().into());
+    put("storage", info.storage.clone().into());
+    put("compression", info.compression.clone().into());
+    put("indexed", info.indexed.into());
+    put("file_size_bytes", info.file_size_bytes.into());
+    put("messages", info.message_count.into());
+    put(
+        "topics",
+        serde_json::to_value(&info.topics).unwrap_or_default(),
+    );
+    if !info.warnings.is_empty() {
+        put("warnings", info.warnings.clone().into());
+    }
+    Ok(summary)
 }
 
 fn detect_dir(path: &Path) -> Result<Format> {

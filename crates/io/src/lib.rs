@@ -41,13 +41,16 @@ mod error;
 mod summary;
 
 pub mod carmen;
+pub mod convert;
 pub mod data;
+pub mod foxglove;
 pub mod kitti;
 pub mod lzw;
 pub mod nclt;
 pub mod octomap;
 pub mod pcd;
 pub mod point_csv;
+pub mod poles_csv;
 pub mod rosbag;
 pub mod segcomp;
 pub mod sequence;

@@ -8,7 +8,7 @@
 //! * **Spatial** — a sequence of timestamped 3-D sweeps with sensor poses
 //!   ([`SweepSequence`]): KITTI sequences, NCLT sessions, rosbag2 recordings
 //!   (`sensor_msgs/msg/PointCloud2`), or sweeps produced in memory ([`SweepSequence::from_fn`]).
-//! * Trajectories ([`crate::tum`]) and pole maps ([`crate::poles`]) are plain tables.
+//! * Trajectories ([`crate::tum`]) and pole maps ([`crate::poles_csv`]) are plain tables.
 //!
 //! ```no_run
 //! use raypath_io::sequence::{PlanarOptions, read_planar};
@@ -26,7 +26,6 @@ pub use planar::{
     CarmenScans, LaserChoice, Origin, PlanarFrame, PlanarOptions, PlanarSource, open_planar,
     read_planar,
 };
-#[allow(unused_imports)] // used by the bag reader
 pub(crate) use sweeps::interpolate;
 pub use sweeps::{SweepError, SweepFn, SweepFormat, SweepOptions, SweepSequence};
 

@@ -42,7 +42,8 @@ enum Source {
 /// odometry sensor pose when the source has them, and the sweep itself, read on demand.
 ///
 /// * **KITTI**: `world_from_velo = velo_from_cam0 · world_from_cam0 · cam0_from_velo` (the
-///   velodyne frame of the first scan is the world frame). KITTI has no odometry: the odometry
+///   velodyne frame of the first scan is the world frame); without `Tr` in `calib.txt` the
+///   poses of `poses.txt` are taken as the velodyne's. KITTI has no odometry: the odometry
 ///   track is the ground truth.
 /// * **NCLT**: scans from `velodyne_sync/` turned to REP-103 axes; ground truth and integrated
 ///   odometry (`odometry_mu_100hz.csv`) interpolated at the scan times (linear in position,
@@ -205,8 +206,8 @@ impl SweepSequence {
         let poses = sequence.poses()?;
         let world_from_velo = match sequence.calib()?.and_then(|c| c.cam0_from_velo()) {
             Some(cam0_from_velo) => kitti::velodyne_poses_from_cam0(&poses, &cam0_from_velo),
-            None if poses.is_empty() => Vec::new(),
-            None => return Err(missing("calib.txt with Tr (needed to use poses.txt)")),
+            // Without `Tr` the poses are taken as the velodyne's own poses.
+            None => poses,
         };
         let mut stamps = Vec::with_capacity(sequence.scan_files.len());
         let mut truth = Vec::with_capacity(sequence.scan_files.len());
