@@ -6,15 +6,17 @@ use std::time::Instant;
 
 use raypath_dct_map::experiment::{auto_patch, draw_rays};
 use raypath_dct_map::{FitConfig, FitProblem, Patch, RangeLimits, Shape, Solver, fit, initial_map};
-use raypath_io::carmen::{CarmenReader, Record};
+use raypath_io::sequence::{LaserChoice, PlanarOptions, read_planar};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
+    let options = PlanarOptions {
+        laser: LaserChoice::Front,
+        ..PlanarOptions::default()
+    };
     let mut rays = Vec::new();
-    for record in CarmenReader::open(std::path::Path::new(&args[1])).unwrap() {
-        if let Record::Laser(l) = record.unwrap() {
-            rays.extend(l.scan.rays(l.world_from_laser));
-        }
+    for f in read_planar(std::path::Path::new(&args[1]), &options).unwrap() {
+        rays.extend(f.scan.rays(f.world_from_laser));
     }
     let n: usize = args[2].parse().unwrap();
     let patch = if args.len() > 4 {

@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use criterion::{Criterion, Throughput, criterion_main};
 use nalgebra::{Point2, Vector2};
 use raypath_geometry::{Aabb2, Grid2, Pose2, Scan2};
-use raypath_io::carmen::{CarmenReader, Record};
+use raypath_io::sequence::{LaserChoice, PlanarOptions, read_planar};
 use raypath_localizer::init::GaussianInit;
 use raypath_localizer::lidar::{LidarConfig, ModelKind, ModelSpec, Scan2Measurement};
 use raypath_localizer::motion::{OdometryControl, OdometryMotionModel};
@@ -27,13 +27,15 @@ const INTEL: &str = "carmen/corrected/intel-corrected.log.gz";
 /// The Intel corrected scans, or `None` when absent.
 fn intel() -> Option<Vec<(Pose2, Scan2)>> {
     let path = raypath_io::data::require(INTEL)?;
-    let reader = CarmenReader::open(&path).ok()?;
+    let options = PlanarOptions {
+        laser: LaserChoice::Front,
+        ..PlanarOptions::default()
+    };
+    let frames = read_planar(&path, &options).ok()?;
     Some(
-        reader
-            .filter_map(|r| match r.ok()? {
-                Record::Laser(m) => Some((m.world_from_laser, m.scan)),
-                _ => None,
-            })
+        frames
+            .into_iter()
+            .map(|f| (f.world_from_laser, f.scan))
             .collect(),
     )
 }

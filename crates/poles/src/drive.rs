@@ -1,5 +1,6 @@
-//! A recorded drive in KITTI or NCLT layout: scan times, ground-truth and odometry sensor
-//! poses per scan, and the scans themselves (read one at a time).
+//! A recorded drive: scan times, ground-truth and odometry sensor poses per scan, and the
+//! scans themselves (read one at a time), on top of [`raypath_io::sequence::SweepSequence`],
+//! which reads the layouts:
 //!
 //! * **KITTI** (`…/sequences/NN/` or a directory with `velodyne/`, `poses.txt`, `times.txt`,
 //!   `calib.txt`): sensor poses `world_from_velo = velo_from_cam0 · world_from_cam0 ·
@@ -10,6 +11,11 @@
 //!   ground truth and the integrated odometry (`odometry_mu_100hz.csv`) interpolated at the
 //!   scan times, in REP-103 frames (`NcltPose::world_from_body`; the body frame is the
 //!   velodyne frame in the simulated sessions — spec errata 24: no extrinsic applied).
+//! * **rosbag2** (a bag directory or `.mcap` file, `sensor_msgs/msg/PointCloud2`; open with
+//!   [`Drive::open_with`] to choose topics): the reference-pose topic is the ground truth;
+//!   without an odometry topic the odometry track is the reference, as for KITTI. A bag
+//!   drive follows KITTI's conventions ([`DriveFormat::Kitti`]; [`Drive::sweep_format`] tells
+//!   it apart).
 //! * **In memory** ([`Drive::from_fn`]): times and poses given by the caller, scans produced
 //!   on demand by a function (e.g. simulated, `raypath_sim::semi_kitti::SemiKittiDrive`), so
 //!   an evaluation streams a drive without writing its scans to disk.
@@ -17,32 +23,42 @@
 use std::path::{Path, PathBuf};
 
 use raypath_geometry::{PointCloud, Pose3};
-use raypath_io::kitti::{self, KittiSequence};
-use raypath_io::nclt::{self, NcltPose, NcltSession};
-use raypath_localizer::PoseTrack;
+use raypath_io::sequence::{SweepFormat, SweepOptions, SweepSequence};
 
 use crate::error::{PoleError, Result};
 
-/// The layout a drive was read from.
+/// The layout a drive was read from, as far as presets and odometry noise go.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DriveFormat {
-    /// KITTI odometry layout.
+    /// KITTI odometry layout (and rosbag2 recordings, which follow its conventions).
     Kitti,
     /// NCLT session layout.
     Nclt,
 }
 
+impl DriveFormat {
+    /// The drive conventions of a sweep layout: a bag follows KITTI's (no recorded odometry
+    /// covariance; the odometry falls back to the reference poses).
+    pub fn of(format: SweepFormat) -> Self {
+        match format {
+            SweepFormat::Nclt => DriveFormat::Nclt,
+            SweepFormat::Kitti | SweepFormat::Bag => DriveFormat::Kitti,
+        }
+    }
+
+    fn sweep_format(self) -> SweepFormat {
+        match self {
+            DriveFormat::Kitti => SweepFormat::Kitti,
+            DriveFormat::Nclt => SweepFormat::Nclt,
+        }
+    }
+}
+
 /// The error a scan function of an in-memory drive may return.
-pub type ScanError = Box<dyn std::error::Error + Send + Sync>;
+pub type ScanError = raypath_io::sequence::SweepError;
 
 /// A scan source of an in-memory drive: scan `index` → points in the sensor frame.
-pub type ScanFn = Box<dyn Fn(usize) -> std::result::Result<PointCloud, ScanError> + Send + Sync>;
-
-enum Source {
-    Kitti { sequence: KittiSequence },
-    Nclt { session: NcltSession },
-    Memory { scan: ScanFn },
-}
+pub type ScanFn = raypath_io::sequence::SweepFn;
 
 /// A drive: per scan a time, a ground-truth sensor pose (when known) and an odometry pose.
 pub struct Drive {
@@ -59,37 +75,60 @@ pub struct Drive {
     /// Per scan: standard deviations `[x m, y m, yaw rad]` of the odometry increment from the
     /// previous scan, when the drive states them (NCLT `odometry_cov.csv`).
     pub odometry_std: Option<Vec<[f64; 3]>>,
-    source: Source,
+    sweeps: SweepSequence,
 }
 
 impl Drive {
-    /// Opens a KITTI sequence or an NCLT session (detected from the directory contents).
-    /// A KITTI dataset root (`sequences/NN/`, `poses/NN.txt`) holding exactly one sequence
-    /// opens that sequence.
+    /// Opens a KITTI sequence, an NCLT session (detected from the directory contents) or a
+    /// rosbag2 recording (topics chosen automatically). A KITTI dataset root
+    /// (`sequences/NN/`, `poses/NN.txt`) holding exactly one sequence opens that sequence.
     pub fn open(dir: &Path) -> Result<Self> {
-        let has = |p: &str| dir.join(p).exists();
-        if has("sequences") && !has("velodyne") {
-            let mut sequences: Vec<PathBuf> = std::fs::read_dir(dir.join("sequences"))
-                .map(|it| it.filter_map(|e| e.ok().map(|e| e.path())).collect())
-                .unwrap_or_default();
-            sequences.retain(|p| p.is_dir());
-            sequences.sort();
-            return match sequences.as_slice() {
-                [one] => Self::open(one),
-                _ => Err(PoleError::Sequence {
-                    path: dir.to_path_buf(),
-                    reason: format!(
-                        "a KITTI root with {} sequences under sequences/: name one (e.g. {})",
-                        sequences.len(),
-                        dir.join("sequences/00").display()
-                    ),
-                }),
-            };
-        }
-        if has("velodyne") || has("poses.txt") || has("calib.txt") || has("times.txt") {
-            return Self::open_kitti(dir);
-        }
-        Self::open_nclt(dir)
+        Self::open_with(dir, &SweepOptions::default())
+    }
+
+    /// Opens a drive like [`Drive::open`], with the topic choice of `options` for bags.
+    ///
+    /// Fails when the drive has no odometry: an NCLT session without odometry covering every
+    /// scan time, a KITTI sequence or bag without a pose for every scan.
+    pub fn open_with(path: &Path, options: &SweepOptions) -> Result<Self> {
+        Self::from_sweeps(SweepSequence::open(path, options)?)
+    }
+
+    /// A drive over a sweep sequence: its reference poses are the ground truth; its odometry
+    /// is the odometry track, or (KITTI, bags) the reference when the source has none.
+    pub fn from_sweeps(mut sweeps: SweepSequence) -> Result<Self> {
+        let missing = |what: &str| PoleError::Sequence {
+            path: sweeps.name.clone(),
+            reason: what.to_owned(),
+        };
+        let ground_truth = sweeps.reference.take();
+        let odometry = match (sweeps.odometry.take(), sweeps.format) {
+            (Some(odometry), _) => odometry,
+            (None, SweepFormat::Nclt) => {
+                return Err(missing(
+                    "the NCLT session has no odometry covering every scan time \
+                     (odometry_mu_100hz.csv)",
+                ));
+            }
+            (None, SweepFormat::Kitti) => ground_truth.clone().ok_or_else(|| {
+                missing(
+                    "the KITTI sequence has no pose for every scan in poses.txt (KITTI \
+                     odometry comes from the poses)",
+                )
+            })?,
+            (None, SweepFormat::Bag) => ground_truth.clone().ok_or_else(|| {
+                missing("the bag has neither odometry nor reference poses for every sweep")
+            })?,
+        };
+        Ok(Self {
+            dir: sweeps.name.clone(),
+            format: DriveFormat::of(sweeps.format),
+            stamps_secs: sweeps.stamps_secs.clone(),
+            ground_truth,
+            odometry,
+            odometry_std: sweeps.odometry_std.take(),
+            sweeps,
+        })
     }
 
     /// A drive from parts held in memory: `name` (used in errors in place of a directory),
@@ -97,8 +136,8 @@ impl Drive {
     /// noise in the CLI), scan times (seconds, strictly increasing), the ground-truth
     /// `world_from_sensor` per scan when known, the odometry `odom_from_sensor` per scan,
     /// and `scan`, which returns scan `index` (points in the sensor frame, REP-103 axes,
-    /// metres) for `index < stamps_secs.len()`. Errors of `scan` become
-    /// [`PoleError::Sequence`] naming the drive and the scan index.
+    /// metres) for `index < stamps_secs.len()`. Errors of `scan` become errors naming the
+    /// drive and the scan (sweep) index.
     ///
     /// Fails when the tracks do not have one pose per time or the times are not strictly
     /// increasing.
@@ -110,151 +149,20 @@ impl Drive {
         odometry: Vec<Pose3>,
         scan: ScanFn,
     ) -> Result<Self> {
-        let dir = PathBuf::from(name);
-        let mismatch = |what: &str, n: usize| PoleError::Sequence {
-            path: dir.clone(),
-            reason: format!("{n} {what} for {} scan times", stamps_secs.len()),
-        };
-        if odometry.len() != stamps_secs.len() {
-            return Err(mismatch("odometry poses", odometry.len()));
-        }
-        if let Some(gt) = &ground_truth
-            && gt.len() != stamps_secs.len()
-        {
-            return Err(mismatch("ground-truth poses", gt.len()));
-        }
-        check_increasing(&dir, &stamps_secs)?;
-        Ok(Self {
-            dir,
-            format,
+        let sweeps = SweepSequence::from_fn(
+            name,
+            format.sweep_format(),
             stamps_secs,
             ground_truth,
-            odometry,
-            odometry_std: None,
-            source: Source::Memory { scan },
-        })
+            Some(odometry),
+            scan,
+        )?;
+        Self::from_sweeps(sweeps)
     }
 
-    fn open_kitti(dir: &Path) -> Result<Self> {
-        let sequence = KittiSequence::open(dir)?;
-        let missing = |what: &str| PoleError::Sequence {
-            path: dir.to_path_buf(),
-            reason: format!("the KITTI sequence has no {what}"),
-        };
-        if sequence.scan_files.is_empty() {
-            return Err(missing("velodyne scans"));
-        }
-        let times = sequence.times()?;
-        let cam0_from_velo = match sequence.calib()? {
-            Some(calib) => calib
-                .cam0_from_velo()
-                .ok_or_else(|| missing("Tr in calib.txt"))?,
-            None => return Err(missing("calib.txt")),
-        };
-        let poses = sequence.poses()?;
-        let world_from_velo = kitti::velodyne_poses_from_cam0(&poses, &cam0_from_velo);
-        let mut stamps = Vec::with_capacity(sequence.scan_files.len());
-        let mut gt = Vec::with_capacity(sequence.scan_files.len());
-        for file in &sequence.scan_files {
-            let frame = file.frame as usize;
-            let t = times
-                .get(frame)
-                .copied()
-                .ok_or_else(|| missing(&format!("time for frame {frame} in times.txt")))?;
-            stamps.push(t);
-            if let Some(p) = world_from_velo.get(frame) {
-                gt.push(*p);
-            }
-        }
-        check_increasing(dir, &stamps)?;
-        let ground_truth = (gt.len() == stamps.len()).then_some(gt);
-        let odometry = ground_truth.clone().ok_or_else(|| {
-            missing("pose for every scan in poses.txt (KITTI odometry comes from the poses)")
-        })?;
-        Ok(Self {
-            dir: dir.to_path_buf(),
-            format: DriveFormat::Kitti,
-            stamps_secs: stamps,
-            ground_truth,
-            odometry,
-            odometry_std: None,
-            source: Source::Kitti { sequence },
-        })
-    }
-
-    fn open_nclt(dir: &Path) -> Result<Self> {
-        let session = NcltSession::open(dir)?;
-        let missing = |what: &str| PoleError::Sequence {
-            path: dir.to_path_buf(),
-            reason: format!("the NCLT session has no {what}"),
-        };
-        if session.sync_files.is_empty() {
-            return Err(missing("velodyne_sync scans"));
-        }
-        let stamps: Vec<f64> = session
-            .sync_files
-            .iter()
-            .map(|f| nclt::utime_to_secs(f.utime))
-            .collect();
-        check_increasing(dir, &stamps)?;
-        let track = |rows: &[NcltPose], what: &str| -> Result<PoseTrack<Pose3>> {
-            let mut stamps_secs = Vec::with_capacity(rows.len());
-            let mut poses = Vec::with_capacity(rows.len());
-            for r in rows {
-                let t = r.stamp_secs();
-                if stamps_secs.last().is_some_and(|&last| t <= last) {
-                    continue;
-                }
-                stamps_secs.push(t);
-                poses.push(r.world_from_body());
-            }
-            PoseTrack::from_parts(stamps_secs, poses).map_err(|e| PoleError::Sequence {
-                path: dir.to_path_buf(),
-                reason: format!("{what}: {e}"),
-            })
-        };
-        let sample = |track: &PoseTrack<Pose3>| -> Option<Vec<Pose3>> {
-            stamps.iter().map(|&t| track.pose_at(t).ok()).collect()
-        };
-        let ground_truth = match session.ground_truth_path {
-            Some(_) => sample(&track(&session.ground_truth()?.poses, "ground truth")?),
-            None => None,
-        };
-        let odometry = match session.odometry_path {
-            Some(_) => sample(&track(&session.odometry()?.poses, "odometry")?)
-                .ok_or_else(|| missing("odometry covering every scan time"))?,
-            None => return Err(missing("odometry_mu_100hz.csv")),
-        };
-        let odometry_std = match session.relative_odometry_cov_path {
-            Some(_) => {
-                let cov = session.relative_odometry_cov()?;
-                let times: Vec<f64> = cov
-                    .records
-                    .iter()
-                    .map(|r| nclt::utime_to_secs(r.utime))
-                    .collect();
-                (!cov.records.is_empty()).then(|| {
-                    stamps
-                        .iter()
-                        .map(|&t| {
-                            let k = times.partition_point(|&s| s < t).min(times.len() - 1);
-                            let m = &cov.records[k].matrix;
-                            [m[(0, 0)], m[(1, 1)], m[(5, 5)]].map(|v| v.max(0.0).sqrt())
-                        })
-                        .collect()
-                })
-            }
-            None => None,
-        };
-        Ok(Self {
-            dir: dir.to_path_buf(),
-            format: DriveFormat::Nclt,
-            stamps_secs: stamps,
-            ground_truth,
-            odometry,
-            odometry_std,
-            source: Source::Nclt { session },
-        })
+    /// The layout the drive was read from, telling bags ([`SweepFormat::Bag`]) apart.
+    pub fn sweep_format(&self) -> SweepFormat {
+        self.sweeps.format
     }
 
     /// Number of scans.
@@ -269,47 +177,19 @@ impl Drive {
 
     /// Reads scan `index` (points in the sensor frame, REP-103 axes).
     pub fn scan(&self, index: usize) -> Result<PointCloud> {
-        let out_of_range = || PoleError::Sequence {
-            path: self.dir.clone(),
-            reason: format!("no scan {index}"),
-        };
-        match &self.source {
-            Source::Kitti { sequence } => {
-                let file = sequence.scan_files.get(index).ok_or_else(out_of_range)?;
-                Ok(kitti::read_velodyne(&file.path)?)
-            }
-            Source::Nclt { session } => {
-                let file = session.sync_files.get(index).ok_or_else(out_of_range)?;
-                let mut cloud = nclt::read_velodyne_sync(&file.path)?;
-                nclt::flu_from_frd(&mut cloud);
-                Ok(cloud)
-            }
-            Source::Memory { scan } => {
-                if index >= self.len() {
-                    return Err(out_of_range());
-                }
-                scan(index).map_err(|e| PoleError::Sequence {
-                    path: self.dir.clone(),
-                    reason: format!("scan {index}: {e}"),
-                })
-            }
+        if index >= self.len() {
+            return Err(PoleError::Sequence {
+                path: self.dir.clone(),
+                reason: format!("no scan {index}"),
+            });
         }
+        Ok(self.sweeps.sweep(index)?)
     }
 
-    /// Total number of points of all scans (from file sizes; an in-memory drive produces
-    /// every scan to count them).
+    /// Total number of points of all scans (from file sizes where the layout allows; other
+    /// drives produce every scan to count them).
     pub fn count_points(&self) -> Result<u64> {
-        Ok(match &self.source {
-            Source::Kitti { sequence } => sequence.count_points()?,
-            Source::Nclt { session } => session.count_points()?,
-            Source::Memory { .. } => {
-                let mut total = 0;
-                for i in 0..self.len() {
-                    total += self.scan(i)?.len() as u64;
-                }
-                total
-            }
-        })
+        Ok(self.sweeps.count_points()?)
     }
 
     /// The ground truth, or an error naming the drive.
@@ -321,19 +201,6 @@ impl Drive {
                 reason: "no ground-truth poses".into(),
             })
     }
-}
-
-fn check_increasing(dir: &Path, stamps: &[f64]) -> Result<()> {
-    if let Some(k) = stamps
-        .windows(2)
-        .position(|w| !(w[0].is_finite() && w[1].is_finite() && w[1] > w[0]))
-    {
-        return Err(PoleError::Sequence {
-            path: dir.to_path_buf(),
-            reason: format!("scan times are not strictly increasing at scan {}", k + 1),
-        });
-    }
-    Ok(())
 }
 
 #[cfg(test)]
@@ -377,7 +244,7 @@ mod tests {
         let failed = drive.scan(3).unwrap_err().to_string();
         assert!(
             failed.contains("memory 00")
-                && failed.contains("scan 3")
+                && failed.contains("sweep 3")
                 && failed.contains("simulated failure"),
             "{failed}"
         );
@@ -439,5 +306,94 @@ mod tests {
         )
         .unwrap();
         assert!(drive.require_ground_truth().is_err());
+    }
+
+    /// A KITTI sequence of three scans on disk, written with the raypath-io writers.
+    fn kitti_on_disk(dir: &Path, with_poses: bool) -> Vec<Pose3> {
+        use nalgebra::Matrix3x4;
+        use raypath_io::kitti;
+        std::fs::create_dir_all(dir.join("velodyne")).unwrap();
+        let world_from_velo: Vec<Pose3> = (0..3)
+            .map(|i| Pose3::from_xyz_rpy(i as f64, 0.5 * i as f64, 0.0, 0.0, 0.0, 0.1 * i as f64))
+            .collect();
+        for i in 0..3 {
+            let cloud = PointCloud::from_points(vec![Point3::new(i as f32, 1.0, 2.0); i + 2]);
+            kitti::write_velodyne(&dir.join(format!("velodyne/{i:06}.bin")), &cloud).unwrap();
+        }
+        let cam0_from_velo = Pose3::from_matrix3x4(&Matrix3x4::new(
+            0.0, -1.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0,
+        ));
+        if with_poses {
+            let cam = kitti::cam0_poses_from_velodyne(&world_from_velo, &cam0_from_velo);
+            kitti::write_poses(&dir.join("poses.txt"), &cam).unwrap();
+        }
+        kitti::write_times(&dir.join("times.txt"), &[0.0, 0.1, 0.2]).unwrap();
+        let p = "7.0 0 6.0 0 0 7.0 1.8 0 0 0 1 0";
+        std::fs::write(
+            dir.join("calib.txt"),
+            format!("P0: {p}\nP1: {p}\nP2: {p}\nP3: {p}\nTr: 0 -1 0 0 0 0 -1 0 1 0 0 0\n"),
+        )
+        .unwrap();
+        world_from_velo
+    }
+
+    #[test]
+    fn kitti_drive_reads_scans_and_velodyne_poses() {
+        let tmp = tempfile::tempdir().unwrap();
+        let seq = tmp.path().join("00");
+        let truth = kitti_on_disk(&seq, true);
+        let drive = Drive::open(&seq).unwrap();
+        assert_eq!(drive.format, DriveFormat::Kitti);
+        assert_eq!(drive.sweep_format(), SweepFormat::Kitti);
+        assert_eq!(drive.stamps_secs, [0.0, 0.1, 0.2]);
+        let gt = drive.require_ground_truth().unwrap();
+        for (read, given) in gt.iter().zip(&truth) {
+            assert!((read.translation() - given.translation()).norm() < 1e-6);
+            assert!(read.rotation().angle_to(&given.rotation()) < 1e-6);
+        }
+        // KITTI has no odometry: the odometry track is the ground truth.
+        assert_eq!(drive.odometry, gt);
+        assert_eq!(drive.scan(1).unwrap().len(), 3);
+        assert_eq!(drive.count_points().unwrap(), 2 + 3 + 4);
+        assert!(drive.scan(3).unwrap_err().to_string().contains("no scan 3"));
+
+        let bare = tmp.path().join("01");
+        kitti_on_disk(&bare, false);
+        let error = Drive::open(&bare)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            error.contains("01") && error.contains("poses.txt"),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn bag_drives_follow_kitti_and_fall_back_to_the_reference() {
+        let reference: Vec<Pose3> = (0..2)
+            .map(|i| Pose3::from_xyz_rpy(i as f64, 0.0, 0.0, 0.0, 0.0, 0.0))
+            .collect();
+        let sweeps = |reference: Option<Vec<Pose3>>| {
+            SweepSequence::from_fn(
+                "bag.mcap",
+                SweepFormat::Bag,
+                vec![0.0, 0.1],
+                reference,
+                None,
+                Box::new(|_| Ok(PointCloud::from_points(Vec::new()))),
+            )
+            .unwrap()
+        };
+        let drive = Drive::from_sweeps(sweeps(Some(reference.clone()))).unwrap();
+        assert_eq!(drive.format, DriveFormat::Kitti);
+        assert_eq!(drive.sweep_format(), SweepFormat::Bag);
+        assert_eq!(drive.odometry, reference);
+        assert_eq!(drive.ground_truth.as_deref(), Some(reference.as_slice()));
+        let error = Drive::from_sweeps(sweeps(None))
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(error.starts_with("bag.mcap: "), "{error}");
     }
 }

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use raypath_geometry::Scan2;
-use raypath_io::carmen::{CarmenReader, Record};
+use raypath_io::sequence::{LaserChoice, PlanarOptions, read_planar};
 use raypath_polylines::{Method, Optimizer, PolylineConfig, extract};
 use raypath_sim::polygons::{PolygonsConfig, simulate_scan};
 
@@ -19,22 +19,17 @@ fn scans() -> (String, Vec<Scan2>) {
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../datasets"));
     let path = dir.join("carmen/corrected/intel-corrected.log.gz");
+    let options = PlanarOptions {
+        laser: LaserChoice::Front,
+        ..PlanarOptions::default()
+    };
     if path.exists()
-        && let Ok(reader) = CarmenReader::open(&path)
+        && let Ok(frames) = read_planar(&path, &options)
     {
-        let all: Vec<Scan2> = reader
-            .filter_map(|r| match r {
-                Ok(Record::Laser(l)) => Some(l.scan),
-                _ => None,
-            })
-            .collect();
-        if !all.is_empty() {
-            let step = (all.len() / 20).max(1);
-            return (
-                "intel".into(),
-                all.into_iter().step_by(step).take(20).collect(),
-            );
-        }
+        // read_planar fails on a log without scans, so `frames` is not empty.
+        let step = (frames.len() / 20).max(1);
+        let scans = frames.into_iter().step_by(step).take(20).map(|f| f.scan);
+        return ("intel".into(), scans.collect());
     }
     eprintln!(
         "{} not found: benchmarking simulated polygon scans",

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use nalgebra::Point2;
 use raypath_geometry::Scan2;
-use raypath_io::carmen::{CarmenReader, Record};
+use raypath_io::sequence::{LaserChoice, PlanarOptions, read_planar};
 use raypath_polylines::metrics::{area_metrics, ray_metrics};
 use raypath_polylines::{Method, Optimizer, PolylineConfig, extract};
 use raypath_sim::polygons::{PolygonsConfig, simulate_scan};
@@ -161,12 +161,14 @@ fn real_scans(per_log: usize) -> Vec<Scan2> {
     paths.sort();
     let mut scans = Vec::new();
     for path in paths.iter().take(4) {
-        let all: Vec<Scan2> = CarmenReader::open(path)
-            .expect("open")
-            .filter_map(|r| match r.expect("record") {
-                Record::Laser(l) => Some(l.scan),
-                _ => None,
-            })
+        let options = PlanarOptions {
+            laser: LaserChoice::Front,
+            ..PlanarOptions::default()
+        };
+        let all: Vec<Scan2> = read_planar(path, &options)
+            .expect("read")
+            .into_iter()
+            .map(|f| f.scan)
             .collect();
         let step = (all.len() / per_log).max(1);
         scans.extend(all.into_iter().step_by(step).take(per_log));

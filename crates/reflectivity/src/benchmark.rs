@@ -1,11 +1,16 @@
 //! Reading CARMEN logs for the matcher and scoring trajectories against reference poses.
 //!
+//! * [`run_matcher`] runs the matcher over any [`LoggedScan`]s: the [`PlanarFrame`]s of
+//!   `raypath_io::sequence` (CARMEN logs with an explicit laser choice, rosbag2 bags) or
+//!   [`LogScan`]s.
 //! * [`read_laser_log`]: the front laser (`FLASER`, or `ROBOTLASER1` when the log has no
-//!   `FLASER`) with its odometry pose and both timestamps (raypath-io reader; `RLASER` is
-//!   skipped).
+//!   `FLASER`) of a CARMEN log with its odometry pose, both timestamps, its line and message
+//!   kind (the CARMEN-specific fields a corrected copy of the log needs; other readers go
+//!   through [`raypath_io::sequence::read_planar`]).
 //! * [`pair_by_ranges`]: the SLAM benchmark's corrected logs are subsampled copies of the raw
 //!   logs with the same range readings (data README), so each reference scan is paired with
-//!   the next raw scan whose readings agree to the centimetre.
+//!   the next raw scan whose readings agree to the centimetre
+//!   ([`raypath_io::sequence::pair_by_ranges`], for [`LogScan`]s).
 //! * [`relative_errors`]: the relative-motion error of Kümmerle et al., "On measuring the
 //!   accuracy of SLAM algorithms" (Autonomous Robots 27(4), 2009): for relations between
 //!   poses `i, j` with reference motion `δ*_ij = G_i⁻¹ G_j` and estimated `δ_ij = E_i⁻¹ E_j`,
@@ -15,11 +20,11 @@
 //! * [`aligned_errors`]: absolute trajectory error after the least-squares rigid alignment
 //!   (2-D Umeyama/Horn without scale) of the estimated positions onto the reference.
 
-use std::collections::HashMap;
 use std::path::Path;
 
 use raypath_geometry::{Pose2, Scan2, wrap_angle};
 use raypath_io::carmen::{CarmenReader, LaserKind, Record};
+use raypath_io::sequence::PlanarFrame;
 use serde::{Deserialize, Serialize};
 
 use crate::calibration::IntensityCorrection;
@@ -44,7 +49,9 @@ pub struct LogScan {
     pub kind: LaserKind,
 }
 
-/// Reads the front-laser scans of a CARMEN log (module docs).
+/// Reads the front-laser scans of a CARMEN log with their CARMEN-specific fields (module
+/// docs); the scans are those of [`raypath_io::sequence::CarmenScans`] with
+/// [`raypath_io::sequence::LaserChoice::Front`].
 pub fn read_laser_log(path: &Path) -> Result<Vec<LogScan>> {
     let reader = CarmenReader::open(path)?;
     let mut front = Vec::new();
@@ -76,11 +83,39 @@ pub fn read_laser_log(path: &Path) -> Result<Vec<LogScan>> {
     Ok(scans)
 }
 
+/// A scan with its logged laser pose, the input of [`run_matcher`].
+pub trait LoggedScan {
+    /// The scan in the laser frame.
+    fn scan(&self) -> &Scan2;
+    /// The logged `world_from_laser` (the odometry in raw logs).
+    fn world_from_laser(&self) -> Pose2;
+}
+
+impl LoggedScan for LogScan {
+    fn scan(&self) -> &Scan2 {
+        &self.scan
+    }
+
+    fn world_from_laser(&self) -> Pose2 {
+        self.world_from_laser
+    }
+}
+
+impl LoggedScan for PlanarFrame {
+    fn scan(&self) -> &Scan2 {
+        &self.scan
+    }
+
+    fn world_from_laser(&self) -> Pose2 {
+        self.world_from_laser
+    }
+}
+
 /// Runs a matcher over the scans of a log: points by `filter` (ϱ̄ by `correction` when the
 /// scans have intensities), odometry increments of the logged poses when `use_odometry`.
 /// Returns the matcher (with its map) and one result per scan.
-pub fn run_matcher(
-    scans: &[LogScan],
+pub fn run_matcher<S: LoggedScan>(
+    scans: &[S],
     config: MatcherConfig,
     filter: &PointFilter,
     correction: Option<&IntensityCorrection>,
@@ -91,42 +126,25 @@ pub fn run_matcher(
     let mut results = Vec::with_capacity(scans.len());
     let mut previous: Option<Pose2> = None;
     for s in scans {
-        points.fill_from_scan(&s.scan, filter, correction);
+        points.fill_from_scan(s.scan(), filter, correction);
+        let world_from_laser = s.world_from_laser();
         let delta = match previous {
-            Some(p) if use_odometry => Some(p.inverse() * s.world_from_laser),
+            Some(p) if use_odometry => Some(p.inverse() * world_from_laser),
             _ => None,
         };
-        previous = Some(s.world_from_laser);
+        previous = Some(world_from_laser);
         results.push(matcher.process(&points, delta));
     }
     Ok((matcher, results))
 }
 
-fn key(scan: &Scan2) -> Vec<i64> {
-    scan.ranges
-        .iter()
-        .map(|r| (r * 100.0).round() as i64)
-        .collect()
-}
-
 /// Pairs each reference scan with a raw scan of the same readings (to 1 cm), in order:
-/// returns `(raw index, reference index)` pairs.
+/// returns `(raw index, reference index)` pairs ([`raypath_io::sequence::pair_by_ranges`]).
 pub fn pair_by_ranges(raw: &[LogScan], reference: &[LogScan]) -> Vec<(usize, usize)> {
-    let mut by_key: HashMap<Vec<i64>, Vec<usize>> = HashMap::new();
-    for (i, s) in raw.iter().enumerate() {
-        by_key.entry(key(&s.scan)).or_default().push(i);
-    }
-    let mut pairs = Vec::new();
-    let mut next = 0;
-    for (j, s) in reference.iter().enumerate() {
-        if let Some(list) = by_key.get(&key(&s.scan)) {
-            if let Some(&i) = list.iter().find(|&&i| i >= next) {
-                pairs.push((i, j));
-                next = i + 1;
-            }
-        }
-    }
-    pairs
+    raypath_io::sequence::pair_by_ranges(
+        raw.iter().map(|s| &s.scan),
+        reference.iter().map(|s| &s.scan),
+    )
 }
 
 /// Mean ± standard deviation (and RMS, maximum) of absolute errors.
@@ -276,5 +294,55 @@ mod tests {
         let r = relative_errors(&reference, &estimate, &consecutive_relations(20));
         assert!(r.translation_m.max < 1e-9 && r.rotation_rad.max < 1e-9);
         assert_eq!(r.translation_m.count, 19);
+    }
+
+    #[test]
+    fn read_laser_log_keeps_the_scans_of_the_front_laser_source() {
+        use raypath_io::carmen::CarmenConfig;
+        use raypath_io::sequence::{CarmenScans, LaserChoice};
+        let robot =
+            "ROBOTLASER1 0 -1.5 3.1 0.01 81.9 0.01 0 2 1 2 2 5 6 0 0 0 0 0 0 0 0 0 0 0 1 h 1";
+        let flaser = [
+            "FLASER 3 1 2 3 0 0 0 0 0 0 2.0 h 2.0",
+            "FLASER 3 2 2 3 1 0 0 1 0 0 4.0 h 4.0",
+        ];
+        let rear = "RLASER 3 4 5 6 0 0 0 0 0 0 3.0 h 3.0";
+        let dir = tempfile::tempdir().unwrap();
+        let logs = [
+            (
+                format!("{robot}\n{}\n{rear}\n{}\n", flaser[0], flaser[1]),
+                2,
+                LaserKind::Front,
+            ),
+            (
+                format!("{robot}\n{rear}\n{robot}\n"),
+                2,
+                LaserKind::RobotLaser1,
+            ),
+        ];
+        for (k, (text, count, kind)) in logs.iter().enumerate() {
+            let path = dir.path().join(format!("{k}.log"));
+            std::fs::write(&path, text).unwrap();
+            let scans = read_laser_log(&path).unwrap();
+            let frames: Vec<PlanarFrame> =
+                CarmenScans::open(&path, LaserChoice::Front, CarmenConfig::default())
+                    .unwrap()
+                    .collect::<raypath_io::Result<_>>()
+                    .unwrap();
+            assert_eq!((scans.len(), frames.len()), (*count, *count));
+            for (s, f) in scans.iter().zip(&frames) {
+                assert_eq!(s.kind, *kind);
+                assert_eq!((&s.scan, s.world_from_laser), (&f.scan, f.world_from_laser));
+                assert_eq!(s.logger_timestamp_secs, f.stamp_secs);
+                assert_eq!(raypath_io::sequence::Origin::Line(s.line), f.origin);
+            }
+            // The matcher reads both alike.
+            let config = MatcherConfig::default();
+            let (_, a) = run_matcher(&scans, config, &PointFilter::default(), None, true).unwrap();
+            let (_, b) = run_matcher(&frames, config, &PointFilter::default(), None, true).unwrap();
+            let poses =
+                |r: &[MatchResult]| r.iter().map(|m| m.world_from_sensor).collect::<Vec<_>>();
+            assert_eq!(poses(&a), poses(&b));
+        }
     }
 }

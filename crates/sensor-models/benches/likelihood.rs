@@ -20,7 +20,7 @@ use std::time::Duration;
 use criterion::{BenchmarkGroup, Criterion, Throughput, criterion_main, measurement::WallTime};
 use nalgebra::{Point2, Point3, Vector2, Vector3};
 use raypath_geometry::{Aabb2, Grid2, Grid3, Pose2, Range, Ray2, Ray3, Scan2};
-use raypath_io::carmen::{CarmenReader, Record};
+use raypath_io::sequence::{LaserChoice, PlanarOptions, read_planar};
 use raypath_sensor_models::{
     BetaPosteriorConfig, DecayRateConfig, DecayRateModel, DecayRatePosteriorModel, DenseStats,
     DenseStats2, DenseStats3, Dimension, GammaPosteriorConfig, LikelihoodFieldConfig,
@@ -44,12 +44,14 @@ impl Rng {
 /// Scans with their poses: the Intel log, or a synthetic room.
 fn scans_2d() -> (&'static str, Vec<(Pose2, Scan2)>) {
     if let Some(path) = raypath_io::data::require("carmen/corrected/intel-corrected.log.gz") {
-        let scans = CarmenReader::open(&path)
+        let options = PlanarOptions {
+            laser: LaserChoice::Front,
+            ..PlanarOptions::default()
+        };
+        let scans = read_planar(&path, &options)
             .unwrap()
-            .filter_map(|r| match r.unwrap() {
-                Record::Laser(m) => Some((m.world_from_laser, m.scan)),
-                _ => None,
-            })
+            .into_iter()
+            .map(|f| (f.world_from_laser, f.scan))
             .collect();
         return ("intel", scans);
     }

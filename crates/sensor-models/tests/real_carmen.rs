@@ -6,7 +6,7 @@
 
 use nalgebra::Point2;
 use raypath_geometry::{Aabb2, Grid2, Pose2, Scan2};
-use raypath_io::carmen::{CarmenReader, Record};
+use raypath_io::sequence::{LaserChoice, PlanarOptions, read_planar};
 use raypath_sensor_models::{
     BetaPosteriorConfig, DecayRateConfig, DecayRateModel2, DecayRatePosteriorModel2, DenseStats2,
     GammaPosteriorConfig, LikelihoodFieldConfig, LikelihoodFieldModel2, LogOddsConfig,
@@ -18,12 +18,14 @@ const LOG: &str = "carmen/corrected/intel-corrected.log.gz";
 
 fn load() -> Option<Vec<(Pose2, Scan2)>> {
     let path = raypath_io::data::require(LOG)?;
-    let reader = CarmenReader::open(&path).expect("open intel log");
-    let scans: Vec<(Pose2, Scan2)> = reader
-        .filter_map(|record| match record.expect("valid record") {
-            Record::Laser(message) => Some((message.world_from_laser, message.scan)),
-            _ => None,
-        })
+    let options = PlanarOptions {
+        laser: LaserChoice::Front,
+        ..PlanarOptions::default()
+    };
+    let scans: Vec<(Pose2, Scan2)> = read_planar(&path, &options)
+        .expect("read intel log")
+        .into_iter()
+        .map(|f| (f.world_from_laser, f.scan))
         .collect();
     assert_eq!(scans.len(), 910);
     Some(scans)

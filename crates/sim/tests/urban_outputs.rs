@@ -8,9 +8,9 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use nalgebra::{Point2, Point3, Unit};
-use raypath_io::kitti::{self, KittiSequence};
 use raypath_io::nclt::{self, NcltSession};
 use raypath_io::point_csv::PointCsv;
+use raypath_io::sequence::{SweepOptions, SweepSequence};
 use raypath_sim::lidar3::Lidar3;
 use raypath_sim::no_progress;
 use raypath_sim::urban::kinds::label;
@@ -73,37 +73,32 @@ fn kitti_style_sequence_reads_back_with_consistent_frames_and_poles() {
     // raypath info on the set's directory (the benchmark root).
     let root = raypath_io::summarize(dir.path()).unwrap();
     assert_eq!((root.scans, root.poses), (Some(4), Some(4)));
-    let sequence = KittiSequence::open(&seq_dir).unwrap();
-    let calib = sequence.calib().unwrap().unwrap();
-    let camera_poses = sequence.poses().unwrap();
+    // The sweeps with their velodyne poses (poses.txt through the Tr of calib.txt).
+    let sequence = SweepSequence::open(&seq_dir, &SweepOptions::default()).unwrap();
+    let world_from_velo = sequence.require_reference().unwrap().to_vec();
     assert!(
-        camera_poses[0].translation().norm() < 1e-9,
+        world_from_velo[0].translation().norm() < 1e-9,
         "first pose is the identity"
     );
-    let world_from_velo =
-        kitti::velodyne_poses_from_cam0(&camera_poses, &calib.cam0_from_velo().unwrap());
-    let times = sequence.times().unwrap();
-    assert!((times[3] - 0.3).abs() < 1e-12);
+    assert!((sequence.stamps_secs[3] - 0.3).abs() < 1e-12);
     // Pole ground truth.
     let poles = PointCsv::read(&seq_dir.join("poles.csv")).unwrap();
     assert_eq!(poles.columns, ["x", "y", "w", "h", "kind", "id"]);
     let by_id: BTreeMap<u32, &[f64]> = poles.rows().map(|r| (r[5] as u32, r)).collect();
     let mut pole_points: BTreeMap<u32, usize> = BTreeMap::new();
     let mut ground = (0usize, 0usize);
-    for (scan, pose) in sequence.scans().zip(&world_from_velo) {
-        let scan = scan.unwrap();
-        let labels_path = seq_dir
-            .join("labels")
-            .join(format!("{:06}.label", scan.frame));
+    for (frame, pose) in world_from_velo.iter().enumerate() {
+        let points = sequence.sweep(frame).unwrap();
+        let labels_path = seq_dir.join("labels").join(format!("{frame:06}.label"));
         let labels: Vec<u32> = std::fs::read(labels_path)
             .unwrap()
             .chunks_exact(4)
             .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
             .collect();
-        assert_eq!(labels.len(), scan.points.len());
-        let intensity = scan.points.intensity.as_ref().unwrap();
+        assert_eq!(labels.len(), points.len());
+        let intensity = points.intensity.as_ref().unwrap();
         assert!(intensity.iter().all(|v| (0.0..=1.0).contains(v)));
-        for (i, p) in scan.points.points.iter().enumerate() {
+        for (i, p) in points.points.iter().enumerate() {
             let w = pose.transform_point(&p.cast::<f64>());
             let class = label::class(labels[i]);
             let local = p.x.hypot(p.y);

@@ -12,6 +12,7 @@ use raypath_geometry::Pose3;
 use raypath_io::data::require;
 use raypath_io::kitti::{self, KittiSequence};
 use raypath_io::point_csv::PointCsv;
+use raypath_io::sequence::{SweepOptions, SweepSequence};
 use raypath_sim::no_progress;
 use raypath_sim::semi_kitti::{
     SemiKittiConfig, SemiKittiDrive, SemiKittiSetConfig, generate, generate_semi_kitti,
@@ -80,14 +81,14 @@ fn a_drive_is_simulated_along_the_given_poses_among_the_given_poles() {
         assert!((row[0] - p.x).abs() < 1e-4 && (row[1] - p.y).abs() < 1e-4);
     }
     assert!(!by_id.contains_key(&0));
-    // Pole returns lie on their poles; most poles are seen.
-    let world_from_velo = kitti::velodyne_poses_from_cam0(&poses, &kitti_cam0_from_velo());
+    // Pole returns lie on their poles; most poles are seen (sweeps and velodyne poses read
+    // back through the source abstraction).
+    let sweeps = SweepSequence::open(&seq_dir, &SweepOptions::default()).unwrap();
     let mut seen = BTreeMap::new();
-    for (scan, pose) in sequence.scans().zip(&world_from_velo) {
-        let scan = scan.unwrap();
-        let labels =
-            std::fs::read(seq_dir.join(format!("labels/{:06}.label", scan.frame))).unwrap();
-        for (p, l) in scan.points.points.iter().zip(labels.chunks_exact(4)) {
+    for (frame, pose) in sweeps.require_reference().unwrap().iter().enumerate() {
+        let points = sweeps.sweep(frame).unwrap();
+        let labels = std::fs::read(seq_dir.join(format!("labels/{frame:06}.label"))).unwrap();
+        for (p, l) in points.points.iter().zip(labels.chunks_exact(4)) {
             let l = u32::from_le_bytes([l[0], l[1], l[2], l[3]]);
             let class = label::class(l);
             if class == label::POLE || class == label::TRUNK {
@@ -157,13 +158,14 @@ fn streamed_scans_equal_the_written_ones() {
     assert_eq!(drive.len(), 4);
     assert_eq!(drive.frames, config.frames());
     let seq_dir = dir.path().join("sequences/09");
-    // Poses and times: the written camera poses map back to the drive's velodyne poses.
-    let sequence = KittiSequence::open(&seq_dir).unwrap();
-    let velo = kitti::velodyne_poses_from_cam0(&sequence.poses().unwrap(), &kitti_cam0_from_velo());
+    // Poses and times: the written sequence reads back as the drive's velodyne poses.
+    let sweeps = SweepSequence::open(&seq_dir, &SweepOptions::default()).unwrap();
+    let velo = sweeps.require_reference().unwrap();
+    assert_eq!(velo.len(), drive.world_from_velo.len());
     for (read, streamed) in velo.iter().zip(&drive.world_from_velo) {
         assert!((read.translation() - streamed.translation()).norm() < 1e-5);
     }
-    assert_eq!(sequence.times().unwrap().len(), drive.times_s.len());
+    assert_eq!(sweeps.stamps_secs.len(), drive.times_s.len());
     // The placed poles are the written ones.
     let written = PointCsv::read(&seq_dir.join("poles.csv")).unwrap();
     assert_eq!(written.len(), drive.poles.len());
@@ -175,7 +177,7 @@ fn streamed_scans_equal_the_written_ones() {
     // Scans in reverse order (no hidden state): bit-equal points, intensities and labels.
     for frame in (0..4).rev() {
         let streamed = drive.scan(frame).unwrap();
-        let file = kitti::read_velodyne(&seq_dir.join(format!("velodyne/{frame:06}.bin"))).unwrap();
+        let file = sweeps.sweep(frame).unwrap();
         assert!(streamed.len() > 1000, "{} points", streamed.len());
         assert_eq!(streamed.points, file.points);
         assert_eq!(streamed.intensity, file.intensity);

@@ -18,7 +18,7 @@ use raypath_dct_map::{
     FitConfig, FitProblem, GridRateMap, MapRay, Patch, RangeLimits, Shape, Solver, fit, initial_map,
 };
 use raypath_geometry::Ray2;
-use raypath_io::carmen::{CarmenReader, Record};
+use raypath_io::sequence::{LaserChoice, PlanarOptions, read_planar};
 use serde_json::json;
 
 use super::{EvalContext, EvalReport};
@@ -80,11 +80,13 @@ struct Cell {
 }
 
 fn log_rays(path: &Path) -> Result<Vec<Ray2>> {
+    let options = PlanarOptions {
+        laser: LaserChoice::Front,
+        ..PlanarOptions::default()
+    };
     let mut rays = Vec::new();
-    for record in CarmenReader::open(path)? {
-        if let Record::Laser(laser) = record? {
-            rays.extend(laser.scan.rays(laser.world_from_laser));
-        }
+    for frame in read_planar(path, &options)? {
+        rays.extend(frame.scan.rays(frame.world_from_laser));
     }
     Ok(rays)
 }

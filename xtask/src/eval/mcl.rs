@@ -3,7 +3,8 @@
 //!
 //! * **Real 2-D** (Radish raw logs `intel`, `fr079`): odometry and scans from the raw log,
 //!   the map (0.1 m) from the corrected log's scans at their corrected poses, ground truth =
-//!   corrected poses paired with raw scans by logger timestamp. The filter runs on the raw
+//!   corrected poses paired with raw scans by identical readings
+//!   (`raypath_io::sequence::pair_reference`). The filter runs on the raw
 //!   scans (an update whenever the odometry moved 0.2 m / 0.2 rad, and at every scan with
 //!   ground truth); the error is evaluated every 1 m of ground-truth path
 //!   (`raypath_localizer::eval`).
@@ -271,7 +272,8 @@ const NOTES: &str = "
 ## Notes
 
 - **Real vs simulated**: `intel` and `fr079` are real Radish logs (raw odometry and scans; map and ground truth \
-from the corrected logs); `indoor/*` and `urban*` are simulated (`datasets/generated`).
+from the corrected logs, paired with the raw scans by identical readings, `raypath_io::sequence::pair_reference`); \
+`indoor/*` and `urban*` are simulated (`datasets/generated`).
 - **Maps and localization scans**: for the real logs the map is built from all corrected scans, which are the \
 same laser readings as the raw scans with ground truth (the corrected logs are subsampled raw logs), so mapping \
 and localization data are not disjoint there (the thesis's are); the raw scans between them are not in the map. \

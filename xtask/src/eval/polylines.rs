@@ -20,7 +20,7 @@ use anyhow::{Context, Result};
 use nalgebra::Point2;
 use rayon::prelude::*;
 use raypath_geometry::Scan2;
-use raypath_io::carmen::{CarmenReader, Record};
+use raypath_io::sequence::{LaserChoice, PlanarOptions, read_planar};
 use raypath_polylines::metrics::{area_metrics, ray_metrics};
 use raypath_polylines::svg::scan_svg;
 use raypath_polylines::{Method, Optimizer, PolylineConfig, extract};
@@ -242,14 +242,15 @@ fn real_samples(ctx: &EvalContext, per_log: usize) -> Result<(Vec<Sample>, Vec<L
         .par_iter()
         .map(|path| {
             let name = log_name(path);
-            let scans = CarmenReader::open(path)?
-                .filter_map(|r| match r {
-                    Ok(Record::Laser(l)) => Some(Ok(l.scan)),
-                    Ok(_) => None,
-                    Err(e) => Some(Err(e)),
-                })
-                .collect::<Result<Vec<_>, _>>()
-                .with_context(|| format!("reading {}", path.display()))?;
+            let options = PlanarOptions {
+                laser: LaserChoice::Front,
+                ..PlanarOptions::default()
+            };
+            let scans: Vec<Scan2> = read_planar(path, &options)
+                .with_context(|| format!("reading {}", path.display()))?
+                .into_iter()
+                .map(|f| f.scan)
+                .collect();
             Ok((name, scans))
         })
         .collect::<Result<_>>()?;

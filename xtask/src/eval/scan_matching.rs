@@ -19,14 +19,16 @@
 mod sim;
 
 use std::fmt::Write;
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
 use raypath_geometry::Pose2;
 use raypath_io::carmen::LaserKind;
+use raypath_io::sequence::{LaserChoice, PlanarFrame, PlanarOptions, pair_reference, read_planar};
 use raypath_reflectivity::benchmark::{
-    AlignedErrors, LogScan, RelativeErrors, aligned_errors, consecutive_relations, pair_by_ranges,
-    read_laser_log, relative_errors, run_matcher,
+    AlignedErrors, LogScan, RelativeErrors, aligned_errors, consecutive_relations, relative_errors,
+    run_matcher,
 };
 use raypath_reflectivity::lut::CalibrationSample;
 use raypath_reflectivity::{
@@ -98,6 +100,28 @@ fn scored_json(s: &Scored) -> Value {
     })
 }
 
+/// The front-laser scans of a log.
+fn front_laser(path: &Path) -> Result<Vec<PlanarFrame>> {
+    let options = PlanarOptions {
+        laser: LaserChoice::Front,
+        ..PlanarOptions::default()
+    };
+    read_planar(path, &options).with_context(|| format!("reading {}", path.display()))
+}
+
+/// Pairs the raw scans with the scans of the corrected log `reference` (identical readings,
+/// `raypath_io::sequence::pair_reference`): the indices of the paired raw scans and their
+/// reference poses, in order.
+fn paired(raw: &mut [PlanarFrame], reference: &Path) -> Result<(Vec<usize>, Vec<Pose2>)> {
+    let reference = front_laser(reference)?;
+    pair_reference(raw, &reference);
+    Ok(raw
+        .iter()
+        .enumerate()
+        .filter_map(|(i, f)| f.reference.map(|pose| (i, pose)))
+        .unzip())
+}
+
 fn real_config() -> MatcherConfig {
     MatcherConfig {
         map: MapConfig {
@@ -141,23 +165,16 @@ fn run_real(ctx: &EvalContext, md: &mut String) -> Result<Value> {
             );
             continue;
         }
-        let mut raw =
-            read_laser_log(&raw_file).with_context(|| format!("reading {}", raw_file.display()))?;
+        let mut raw = front_laser(&raw_file)?;
         if let Some(n) = limit {
             raw.truncate(n);
         }
-        let reference =
-            read_laser_log(&ref_file).with_context(|| format!("reading {}", ref_file.display()))?;
-        let pairs = pair_by_ranges(&raw, &reference);
-        let truth: Vec<Pose2> = pairs
-            .iter()
-            .filter_map(|&(_, j)| reference.get(j).map(|s| s.world_from_laser))
-            .collect();
+        let (pairs, truth) = paired(&mut raw, &ref_file)?;
         let relations = consecutive_relations(truth.len());
         let score = |poses: &[Pose2], seconds: f64| -> Scored {
             let est: Vec<Pose2> = pairs
                 .iter()
-                .filter_map(|&(i, _)| poses.get(i).copied())
+                .filter_map(|&i| poses.get(i).copied())
                 .collect();
             Scored {
                 relative: relative_errors(&truth, &est, &relations),
@@ -236,18 +253,11 @@ fn run_generated(ctx: &EvalContext, md: &mut String, lut: &IntensityCorrection) 
         );
         return Ok(Value::Null);
     };
-    let mut raw =
-        read_laser_log(&raw_file).with_context(|| format!("reading {}", raw_file.display()))?;
+    let mut raw = front_laser(&raw_file)?;
     if ctx.quick {
         raw.truncate(300);
     }
-    let reference =
-        read_laser_log(&ref_file).with_context(|| format!("reading {}", ref_file.display()))?;
-    let pairs = pair_by_ranges(&raw, &reference);
-    let truth: Vec<Pose2> = pairs
-        .iter()
-        .filter_map(|&(_, j)| reference.get(j).map(|s| s.world_from_laser))
-        .collect();
+    let (pairs, truth) = paired(&mut raw, &ref_file)?;
     let relations = consecutive_relations(truth.len());
     let mut table = Table::new([
         "residual",
@@ -261,7 +271,7 @@ fn run_generated(ctx: &EvalContext, md: &mut String, lut: &IntensityCorrection) 
     let mut out = Vec::new();
     let odometry: Vec<Pose2> = pairs
         .iter()
-        .filter_map(|&(i, _)| raw.get(i).map(|s| s.world_from_laser))
+        .filter_map(|&i| raw.get(i).map(|s| s.world_from_laser))
         .collect();
     let mut rows = vec![(
         "—".to_string(),
@@ -286,7 +296,7 @@ fn run_generated(ctx: &EvalContext, md: &mut String, lut: &IntensityCorrection) 
             let sps = raw.len() as f64 / t.elapsed().as_secs_f64();
             let est: Vec<Pose2> = pairs
                 .iter()
-                .filter_map(|&(i, _)| results.get(i).map(|r| r.world_from_sensor))
+                .filter_map(|&i| results.get(i).map(|r| r.world_from_sensor))
                 .collect();
             rows.push((
                 mode.name().to_string(),
@@ -601,10 +611,7 @@ fn run_failure_case(
 
 /// Writes the occupancy of a level as a PNG (free white, occupied black, unknown grey),
 /// cropped to the observed cells.
-fn write_occupancy_png(
-    level: &raypath_reflectivity::GridLevel,
-    path: &std::path::Path,
-) -> Result<()> {
+fn write_occupancy_png(level: &raypath_reflectivity::GridLevel, path: &Path) -> Result<()> {
     let (mut i0, mut j0, mut i1, mut j1) = (usize::MAX, usize::MAX, 0, 0);
     for j in 0..level.height() {
         for i in 0..level.width() {

@@ -5,9 +5,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use raypath_geometry::Range;
-use raypath_io::carmen::{CarmenReader, Record};
-use raypath_io::kitti::{self, KittiSequence};
 use raypath_io::pcd::{self, ReadOptions};
+use raypath_io::sequence::{
+    LaserChoice, PlanarOptions, PlanarSource, SweepOptions, SweepSequence, open_planar,
+};
 use raypath_sim::datasets::SETS;
 use serde_json::Value;
 
@@ -323,19 +324,26 @@ fn comparison_table(sets: &[SetOnDisk], ctx: &EvalContext) -> Result<Table> {
     Ok(table)
 }
 
+/// The front-laser scans of a CARMEN log.
+fn front_laser(path: &Path) -> Result<Box<dyn PlanarSource>> {
+    let options = PlanarOptions {
+        laser: LaserChoice::Front,
+        ..PlanarOptions::default()
+    };
+    Ok(open_planar(path, &options)?)
+}
+
 /// Scans, beams and mean hit range of a real corrected log.
 fn real_log_stats(path: &Path) -> Option<(usize, usize, f64)> {
-    let reader = CarmenReader::open(path).ok()?;
+    let frames = front_laser(path).ok()?;
     let (mut scans, mut beams, mut sum, mut hits) = (0, 0, 0.0, 0usize);
-    for record in reader.flatten() {
-        if let Record::Laser(laser) = record {
-            scans += 1;
-            beams = laser.scan.len();
-            for i in 0..laser.scan.len() {
-                if let Range::Hit(r) = laser.scan.range(i) {
-                    sum += r;
-                    hits += 1;
-                }
+    for frame in frames.flatten() {
+        scans += 1;
+        beams = frame.scan.len();
+        for i in 0..frame.scan.len() {
+            if let Range::Hit(r) = frame.scan.range(i) {
+                sum += r;
+                hits += 1;
             }
         }
     }
@@ -424,11 +432,7 @@ fn polygons_picture(set: &SetOnDisk, path: &Path) -> Result<bool> {
         .iter()
         .filter_map(|v| Some((v[0].as_f64()?, v[1].as_f64()?)))
         .collect();
-    let reader = CarmenReader::open(&set.dir.join("polygons.log"))?;
-    let Some(scan) = reader.flatten().find_map(|r| match r {
-        Record::Laser(laser) => Some(laser),
-        _ => None,
-    }) else {
+    let Some(scan) = front_laser(&set.dir.join("polygons.log"))?.flatten().next() else {
         return Ok(false);
     };
     let points: Vec<(f64, f64)> = scan
@@ -453,19 +457,16 @@ fn polygons_picture(set: &SetOnDisk, path: &Path) -> Result<bool> {
 }
 
 fn log_picture(log: &Path, path: &Path) -> Result<bool> {
-    let reader = CarmenReader::open(log)?;
     let mut hits = Vec::new();
     let mut trajectory = Vec::new();
-    for record in reader.flatten() {
-        if let Record::Laser(laser) = record {
-            trajectory.push((laser.world_from_laser.x(), laser.world_from_laser.y()));
-            hits.extend(
-                laser
-                    .scan
-                    .points(laser.world_from_laser)
-                    .map(|p| (p.x, p.y)),
-            );
-        }
+    for frame in front_laser(log)?.flatten() {
+        trajectory.push((frame.world_from_laser.x(), frame.world_from_laser.y()));
+        hits.extend(
+            frame
+                .scan
+                .points(frame.world_from_laser)
+                .map(|p| (p.x, p.y)),
+        );
     }
     let Some(mut top) = TopDown::fit(&hits, 0.001, 0.05, 900.0) else {
         return Ok(false);
@@ -534,18 +535,14 @@ fn kitti_top_down(set: &SetOnDisk, path: &Path) -> Result<bool> {
     let Some(dir) = sequence_dir(set) else {
         return Ok(false);
     };
-    let sequence = KittiSequence::open(&dir)?;
-    let Some(cam0_from_velo) = sequence.calib()?.and_then(|c| c.cam0_from_velo()) else {
+    let sequence = SweepSequence::open(&dir, &SweepOptions::default())?;
+    let Some(world_from_velo) = sequence.reference.as_deref() else {
         return Ok(false);
     };
-    let world_from_velo = kitti::velodyne_poses_from_cam0(&sequence.poses()?, &cam0_from_velo);
     let mut hits = Vec::new();
-    for (i, scan) in sequence.scans().enumerate().step_by(5) {
-        let scan = scan?;
-        let Some(pose) = world_from_velo.get(i) else {
-            break;
-        };
-        for p in scan.points.points.iter().step_by(4) {
+    for (i, pose) in world_from_velo.iter().enumerate().step_by(5) {
+        let scan = sequence.sweep(i)?;
+        for p in scan.points.iter().step_by(4) {
             let q = pose.transform_point(&p.cast::<f64>());
             hits.push((q.x, q.y));
         }
@@ -574,11 +571,11 @@ fn kitti_range_image(set: &SetOnDisk, path: &Path) -> Result<bool> {
     let Some(dir) = sequence_dir(set) else {
         return Ok(false);
     };
-    let sequence = KittiSequence::open(&dir)?;
-    let Some(scan) = sequence.scans().next() else {
+    let sequence = SweepSequence::open(&dir, &SweepOptions::default())?;
+    if sequence.is_empty() {
         return Ok(false);
-    };
-    let cloud = scan?.points;
+    }
+    let cloud = sequence.sweep(0)?;
     // One row per laser: each point goes to the laser of nearest elevation (the HDL-64E's
     // elevations are not evenly spaced, so a uniform spherical grid would leave empty rows).
     let mut elevations = raypath_sim::lidar3::Lidar3::hdl64e().elevations_rad;

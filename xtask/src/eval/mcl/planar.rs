@@ -1,5 +1,6 @@
 //! 2-D MCL on CARMEN logs: raw log (odometry + scans) against a map and ground truth from the
-//! corrected log (real Radish logs and the simulated indoor worlds).
+//! corrected log (real Radish logs and the simulated indoor worlds), read and paired through
+//! `raypath_io::sequence` (front laser; raw and corrected scans paired by identical readings).
 
 use std::path::Path;
 use std::time::Instant;
@@ -7,7 +8,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use nalgebra::{Point2, Vector2};
 use raypath_geometry::{Aabb2, Grid2, Pose2, Scan2};
-use raypath_io::carmen::CarmenReader;
+use raypath_io::sequence::{LaserChoice, PlanarFrame, PlanarOptions, pair_reference, read_planar};
 use raypath_localizer::eval::{EvaluationConfig, evaluate_trajectory};
 use raypath_localizer::init::{GaussianInit, Initializer};
 use raypath_localizer::lidar::{
@@ -20,9 +21,6 @@ use super::common::{Cell, RunResult};
 
 /// Map cell size for the 2-D maps, metres.
 pub const CELL_M: f64 = 0.1;
-/// Largest gap between a corrected and a raw logger timestamp that still pairs them, seconds
-/// (the corrected logs print the raw stamp with fewer digits).
-const MATCH_TOLERANCE_SECS: f64 = 2e-3;
 
 /// A 2-D localization problem: map statistics, the raw steps, and the ground truth.
 pub struct PlanarProblem {
@@ -42,19 +40,12 @@ pub struct PlanarProblem {
     pub corrected_scans: usize,
 }
 
-fn read_scans(path: &Path) -> Result<Vec<(f64, Pose2, Pose2, Scan2)>> {
-    let reader = CarmenReader::open(path).with_context(|| format!("opening {}", path.display()))?;
-    let mut out = Vec::new();
-    for m in reader.front_lasers() {
-        let m = m?;
-        out.push((
-            m.logger_timestamp_secs,
-            m.world_from_robot,
-            m.world_from_laser,
-            m.scan,
-        ));
-    }
-    Ok(out)
+fn read_scans(path: &Path) -> Result<Vec<PlanarFrame>> {
+    let options = PlanarOptions {
+        laser: LaserChoice::Front,
+        ..PlanarOptions::default()
+    };
+    read_planar(path, &options).with_context(|| format!("reading {}", path.display()))
 }
 
 /// Loads `raw` and `corrected`, builds the map from the corrected scans and pairs the
@@ -65,19 +56,17 @@ pub fn load(
     corrected: &Path,
     max_gt_scans: Option<usize>,
 ) -> Result<PlanarProblem> {
-    let raw_scans = read_scans(raw)?;
+    let mut raw_scans = read_scans(raw)?;
     let corrected_scans = read_scans(corrected)?;
-    if raw_scans.is_empty() || corrected_scans.is_empty() {
-        bail!("{name}: no laser scans");
-    }
-    let robot_from_laser = raw_scans[0].1.inverse() * raw_scans[0].2;
+    let robot_from_laser = raw_scans[0].robot_from_laser();
 
     // Map from all corrected scans at their corrected laser poses.
     let mut bounds = Aabb2::empty();
     let mapping = MappingConfig::default();
-    for (_, _, pose, scan) in &corrected_scans {
+    for frame in &corrected_scans {
+        let (pose, scan) = (frame.world_from_laser, &frame.scan);
         bounds.extend(&Point2::new(pose.x(), pose.y()));
-        for (i, p) in scan.points(*pose).enumerate() {
+        for (i, p) in scan.points(pose).enumerate() {
             if let raypath_geometry::Range::Hit(r) = scan.range(i)
                 && r < mapping.range.max_range_m
             {
@@ -91,36 +80,25 @@ pub fn load(
         CELL_M,
     )?;
     let mut stats = DenseStats2::new(grid);
-    let refs: Vec<(Pose2, &Scan2)> = corrected_scans.iter().map(|(_, _, p, s)| (*p, s)).collect();
+    let refs: Vec<(Pose2, &Scan2)> = corrected_scans
+        .iter()
+        .map(|f| (f.world_from_laser, &f.scan))
+        .collect();
     stats.insert_scans_par(&refs, &mapping);
 
-    // Pair corrected scans with raw scans by logger timestamp.
-    let raw_stamps: Vec<f64> = raw_scans.iter().map(|s| s.0).collect();
+    // Pair corrected scans with raw scans by identical readings; keep strictly increasing
+    // times (raw logs repeat a logger stamp now and then).
+    pair_reference(&mut raw_scans, &corrected_scans);
     let mut matched: Vec<(usize, Pose2)> = Vec::new();
-    for (stamp, _, world_from_laser, _) in &corrected_scans {
-        let i = raw_stamps.partition_point(|t| t < stamp);
-        let best = [i.wrapping_sub(1), i]
-            .into_iter()
-            .filter_map(|j| raw_stamps.get(j).map(|t| (j, (t - stamp).abs())))
-            .min_by(|a, b| a.1.total_cmp(&b.1));
-        if let Some((j, gap)) = best
-            && gap <= MATCH_TOLERANCE_SECS
+    let mut last_stamp = f64::NEG_INFINITY;
+    for (j, frame) in raw_scans.iter().enumerate() {
+        if let Some(world_from_laser) = frame.reference
+            && frame.stamp_secs > last_stamp
         {
-            matched.push((j, *world_from_laser * robot_from_laser.inverse()));
+            last_stamp = frame.stamp_secs;
+            matched.push((j, world_from_laser * robot_from_laser.inverse()));
         }
     }
-    matched.sort_by_key(|m| m.0);
-    matched.dedup_by_key(|m| m.0);
-    // Keep strictly increasing times (raw logs repeat a logger stamp now and then).
-    let mut last_stamp = f64::NEG_INFINITY;
-    matched.retain(|(j, _)| {
-        let t = raw_stamps.get(*j).copied().unwrap_or(f64::NAN);
-        let keep = t > last_stamp;
-        if keep {
-            last_stamp = t;
-        }
-        keep
-    });
     if matched.len() < 2 {
         bail!(
             "{name}: only {} corrected scans matched raw scans",
@@ -136,17 +114,17 @@ pub fn load(
     let steps: Vec<PlanarStep> = raw_scans[first..=last]
         .iter()
         .enumerate()
-        .map(|(k, (stamp, odom, _, scan))| PlanarStep {
-            stamp_secs: *stamp,
-            odom_from_robot: *odom,
-            scan: scan.clone(),
+        .map(|(k, frame)| PlanarStep {
+            stamp_secs: frame.stamp_secs,
+            odom_from_robot: frame.world_from_robot,
+            scan: frame.scan.clone(),
             force_update: forced.contains(&(first + k)),
         })
         .collect();
     let ground_truth = PoseTrack::new(
         matched
             .iter()
-            .filter_map(|(j, pose)| raw_scans.get(*j).map(|s| Stamped::new(s.0, *pose))),
+            .filter_map(|(j, pose)| raw_scans.get(*j).map(|f| Stamped::new(f.stamp_secs, *pose))),
     )?;
     Ok(PlanarProblem {
         name: name.to_owned(),

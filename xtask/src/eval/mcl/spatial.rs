@@ -7,7 +7,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use nalgebra::Point3;
 use raypath_geometry::{Aabb3, Grid3, PointCloud, Pose3, Range, Ray3};
-use raypath_io::kitti::{KittiSequence, flu_from_camera};
+use raypath_io::sequence::{SweepOptions, SweepSequence};
 use raypath_localizer::eval::{EvaluationConfig, evaluate_trajectory};
 use raypath_localizer::init::{GaussianInit, Initializer};
 use raypath_localizer::lidar::{LidarConfig, Scan3Measurement};
@@ -54,26 +54,19 @@ fn rays_of(cloud: &PointCloud) -> Vec<Ray3> {
         .collect()
 }
 
-/// Loads the first `frames` scans of sequence 00 under `root`.
+/// Loads the first `frames` scans of sequence 00 under `root` (poses in the world frame of
+/// [`SweepSequence`]: the velodyne frame of the first scan).
 pub fn load(root: &Path, frames: usize) -> Result<SpatialProblem> {
-    let seq = KittiSequence::open(&root.join("sequences/00"))
+    let seq = SweepSequence::open(&root.join("sequences/00"), &SweepOptions::default())
         .with_context(|| format!("opening {}", root.display()))?;
-    let poses = seq.poses()?;
-    let times = seq.times()?;
-    let calib = seq.calib()?.context("urban-kitti has no calib.txt")?;
-    let cam0_from_velo = calib
-        .cam0_from_velo()
-        .context("calib.txt has no Tr (cam0_from_velo)")?;
-    let n = frames.min(poses.len()).min(seq.scan_files.len());
+    let poses = seq.require_reference()?;
+    let n = frames.min(seq.len());
     if n < 4 {
         bail!("urban-kitti: only {n} frames");
     }
-    let world_from_velo: Vec<Pose3> = poses[..n]
-        .iter()
-        .map(|p| flu_from_camera() * *p * cam0_from_velo)
-        .collect();
+    let world_from_velo = &poses[..n];
     let mut bounds = Aabb3::empty();
-    for pose in &world_from_velo {
+    for pose in world_from_velo {
         let t = pose.translation();
         bounds.extend(&Point3::new(t.x - 40.0, t.y - 40.0, t.z - 4.0));
         bounds.extend(&Point3::new(t.x + 40.0, t.y + 40.0, t.z + 16.0));
@@ -89,11 +82,7 @@ pub fn load(root: &Path, frames: usize) -> Result<SpatialProblem> {
     // Map from even frames (in batches to bound memory), localize on odd frames.
     let mut batch: Vec<(Pose3, PointCloud)> = Vec::new();
     for (i, pose) in world_from_velo.iter().enumerate() {
-        let frame = seq.scan_files[i].frame;
-        let cloud = seq
-            .scan(frame)
-            .context("missing scan")?
-            .with_context(|| format!("reading frame {frame}"))?;
+        let cloud = seq.sweep(i).with_context(|| format!("reading sweep {i}"))?;
         if i % 2 == 0 {
             batch.push((*pose, cloud));
             if batch.len() >= 16 {
@@ -102,8 +91,7 @@ pub fn load(root: &Path, frames: usize) -> Result<SpatialProblem> {
                 batch.clear();
             }
         } else {
-            let stamp = times.get(i).copied().unwrap_or(i as f64 * 0.1);
-            frames_out.push((stamp, *pose, rays_of(&cloud)));
+            frames_out.push((seq.stamps_secs[i], *pose, rays_of(&cloud)));
         }
     }
     let refs: Vec<(Pose3, &PointCloud)> = batch.iter().map(|(p, c)| (*p, c)).collect();

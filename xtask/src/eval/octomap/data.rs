@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use nalgebra::Point3;
 use raypath_geometry::{PointCloud, Pose3};
-use raypath_io::kitti::KittiSequence;
 use raypath_io::octomap::{ScanGraph, ScanNode, write_graph_file};
+use raypath_io::sequence::{SweepOptions, SweepSequence};
 
 use super::super::EvalContext;
 
@@ -84,7 +84,8 @@ pub fn scan_dat(ctx: &EvalContext, stride: usize, repeat: usize) -> Result<Optio
 }
 
 /// A simulated urban drive (HDL-64E, `raypath-sim` urban-kitti set): `scans` scans taken
-/// every `frame_step` frames, every `stride`-th point, in a REP-103 world frame.
+/// every `frame_step` frames, every `stride`-th point, in the REP-103 world frame of
+/// [`SweepSequence`] (the velodyne frame of the first scan).
 pub fn urban(
     ctx: &EvalContext,
     scans: usize,
@@ -98,30 +99,21 @@ pub fn urban(
             return Ok(None);
         }
     };
-    let sequence = KittiSequence::open(&root.join("sequences/00"))?;
-    let cam_poses = sequence.poses()?;
-    let calib = sequence.calib()?.context("urban-kitti has no calib.txt")?;
-    let cam0_from_velo = calib.cam0_from_velo().context("calib without Tr")?;
-    let flu = raypath_io::kitti::flu_from_camera();
+    let sequence = SweepSequence::open(&root.join("sequences/00"), &SweepOptions::default())?;
+    let poses = sequence.require_reference()?;
     let mut nodes = Vec::new();
-    for (i, file) in sequence
-        .scan_files
-        .iter()
+    for (i, k) in (0..sequence.len())
         .step_by(frame_step)
         .take(scans)
         .enumerate()
     {
-        let Some(world_from_cam0) = cam_poses.get(file.frame as usize) else {
-            continue;
-        };
-        let world_from_velo = flu * *world_from_cam0 * cam0_from_velo;
-        let cloud = raypath_io::kitti::read_velodyne(&file.path)?;
+        let cloud = sequence.sweep(k)?;
         let points: Vec<_> = (0..cloud.len())
             .step_by(stride)
             .filter(|&j| cloud.is_valid(j))
             .map(|j| cloud.points[j])
             .collect();
-        nodes.push(node(i as u32, world_from_velo, points));
+        nodes.push(node(i as u32, poses[k], points));
     }
     let graph = ScanGraph {
         nodes,

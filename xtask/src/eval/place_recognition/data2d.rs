@@ -5,7 +5,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use raypath_geometry::{Pose2, Scan2};
-use raypath_reflectivity::benchmark::read_laser_log;
+use raypath_io::sequence::{LaserChoice, PlanarFrame, PlanarOptions, read_planar};
 
 /// The corrected logs with loops: name and path under `RAYPATH_DATA`.
 pub const LOGS: [(&str, &str); 10] = [
@@ -46,13 +46,21 @@ pub struct Log2 {
     pub stride: usize,
 }
 
+/// The front-laser scans of a log.
+fn front_laser(path: &Path) -> Result<Vec<PlanarFrame>> {
+    let options = PlanarOptions {
+        laser: LaserChoice::Front,
+        ..PlanarOptions::default()
+    };
+    read_planar(path, &options).with_context(|| format!("reading {}", path.display()))
+}
+
 /// Reads a log, keeping every `stride`-th scan.
 pub fn load(path: &Path, stride: usize) -> Result<Log2> {
-    let all = read_laser_log(path).with_context(|| format!("reading {}", path.display()))?;
-    let (scans, poses) = all
+    let (scans, poses) = front_laser(path)?
         .into_iter()
         .step_by(stride.max(1))
-        .map(|s| (s.scan, s.world_from_laser))
+        .map(|f| (f.scan, f.world_from_laser))
         .unzip();
     Ok(Log2 {
         scans,
@@ -75,7 +83,7 @@ impl Log2 {
 
 /// Reads up to `max` scans of a raw log (no reference poses needed: speed only).
 pub fn load_scans(path: &Path, max: usize) -> Result<Vec<Scan2>> {
-    let mut all = read_laser_log(path).with_context(|| format!("reading {}", path.display()))?;
+    let mut all = front_laser(path)?;
     all.truncate(max);
-    Ok(all.into_iter().map(|s| s.scan).collect())
+    Ok(all.into_iter().map(|f| f.scan).collect())
 }

@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 use image::GrayImage;
 use rayon::prelude::*;
 use raypath_geometry::{PointCloud, Pose3};
-use raypath_io::kitti::KittiSequence;
+use raypath_io::sequence::{SweepOptions, SweepSequence};
 use raypath_place_recognition::{
     BinaryVocabulary, EquirectConfig, Exclusion, GroundTruth, equirectangular,
 };
@@ -28,12 +28,13 @@ use crate::table::{Table, fmt_num};
 
 /// The real sequences and frames.
 pub const SEQUENCES: [&str; 4] = ["00", "01", "04", "07"];
-const FRAMES: u64 = 10;
+const FRAMES: usize = 10;
 
-/// The real frames (sequence index, views), their camera poses and the sequences found.
+/// The real frames (sequence index, views), their velodyne poses and the sequences found.
 type Loaded = (Vec<(usize, Views)>, Vec<Pose3>, Vec<&'static str>);
 
-/// Reads the real frames and their camera poses; the sequences found.
+/// Reads the real frames and their velodyne poses (`SweepSequence`: `poses.txt` through the
+/// `Tr` of `calib.txt`); the sequences found.
 fn load(ctx: &EvalContext) -> Result<Loaded> {
     let mut frames = Vec::new();
     let mut poses = Vec::new();
@@ -43,15 +44,15 @@ fn load(ctx: &EvalContext) -> Result<Loaded> {
         if !dir.exists() {
             continue;
         }
-        let sequence = KittiSequence::open(&dir)?;
-        let seq_poses = sequence.poses()?;
-        let clouds: Vec<PointCloud> = (0..FRAMES)
-            .filter_map(|f| sequence.scan(f))
-            .collect::<std::result::Result<_, _>>()
-            .with_context(|| format!("reading {}", dir.display()))?;
-        if clouds.len() != FRAMES as usize || seq_poses.len() < FRAMES as usize {
+        let sequence = SweepSequence::open(&dir, &SweepOptions::default())?;
+        let seq_poses = sequence.reference.as_deref().unwrap_or_default();
+        if sequence.len() < FRAMES || seq_poses.len() < FRAMES {
             continue;
         }
+        let clouds: Vec<PointCloud> = (0..FRAMES)
+            .map(|i| sequence.sweep(i))
+            .collect::<std::result::Result<_, _>>()
+            .with_context(|| format!("reading {}", dir.display()))?;
         let views: Vec<(usize, Views)> = clouds
             .into_par_iter()
             .map(|cloud| {
@@ -69,7 +70,7 @@ fn load(ctx: &EvalContext) -> Result<Loaded> {
             })
             .collect::<Result<_>>()?;
         frames.extend(views);
-        poses.extend_from_slice(&seq_poses[..FRAMES as usize]);
+        poses.extend_from_slice(&seq_poses[..FRAMES]);
         found.push(*seq);
     }
     Ok((frames, poses, found))
@@ -88,7 +89,7 @@ fn simulated_images(ctx: &EvalContext, seq: &str) -> Result<Option<Vec<GrayImage
         &dir.join("poles.csv"),
     )?;
     config.sequence = seq.to_owned();
-    config.max_scans = Some(FRAMES as usize);
+    config.max_scans = Some(FRAMES);
     config.labels = false;
     let drive = SemiKittiDrive::new(&config, DEFAULT_SEED)?;
     let images = (0..drive.len())
@@ -208,8 +209,8 @@ pub fn run(ctx: &EvalContext, vocabulary: Option<&Arc<BinaryVocabulary>>) -> Res
     }
     writeln!(
         md,
-        "Sequences {} (frames 0–9 each, real HDL-64E scans with real intensity; camera poses of \
-         `poses.txt`) in one database of {n} frames; every frame queried against all (kidnapped, \
+        "Sequences {} (frames 0–9 each, real HDL-64E scans with real intensity; velodyne poses \
+         from `poses.txt` and `calib.txt`) in one database of {n} frames; every frame queried against all (kidnapped, \
          no temporal consistency). A best match counts as a neighbour when it is another frame \
          of the same sequence, and as correct when it is also less than 5 m away (the true \
          pairs: {}). Images: equirectangular 1024 × 64, elevation −24.9°…+2°, intensity scaled \

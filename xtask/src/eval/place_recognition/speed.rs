@@ -9,7 +9,7 @@ use std::time::Instant;
 use anyhow::{Result, anyhow};
 use nalgebra::{Point3, Vector3};
 use raypath_geometry::{PointCloud, Scan2};
-use raypath_io::kitti::KittiSequence;
+use raypath_io::sequence::{SweepOptions, SweepSequence};
 use raypath_place_recognition::{
     Frame, Ibuild, IbuildConfig, PlaceRecognizer, ScanContext, ScanContextConfig, StageTimes,
     VocabularySearch,
@@ -207,11 +207,9 @@ fn real_clouds(ctx: &EvalContext) -> Result<Vec<PointCloud>> {
         if !dir.exists() {
             continue;
         }
-        let sequence = KittiSequence::open(&dir)?;
-        for f in 0..10 {
-            if let Some(cloud) = sequence.scan(f) {
-                out.push(cloud?);
-            }
+        let sequence = SweepSequence::open(&dir, &SweepOptions::default())?;
+        for i in 0..sequence.len().min(10) {
+            out.push(sequence.sweep(i)?);
         }
     }
     Ok(out)

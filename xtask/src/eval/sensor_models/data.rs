@@ -3,21 +3,22 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use nalgebra::Point3;
 use raypath_geometry::{Pose2, Pose3, Ray3, Scan2};
-use raypath_io::carmen::{CarmenReader, Record};
-use raypath_io::kitti::{KittiSequence, flu_from_camera, velodyne_poses};
+use raypath_io::sequence::{LaserChoice, PlanarOptions, SweepOptions, SweepSequence, read_planar};
 
-/// The laser scans of a CARMEN log with their reference poses.
+/// The front-laser scans of a CARMEN log (or a bag) with their logged (reference) poses.
 pub fn carmen_scans(path: &Path) -> Result<Vec<(Pose2, Scan2)>> {
-    let mut scans = Vec::new();
-    for record in CarmenReader::open(path)? {
-        if let Record::Laser(laser) = record? {
-            scans.push((laser.world_from_laser, laser.scan));
-        }
-    }
-    Ok(scans)
+    let options = PlanarOptions {
+        laser: LaserChoice::Front,
+        ..PlanarOptions::default()
+    };
+    let frames = read_planar(path, &options)?;
+    Ok(frames
+        .into_iter()
+        .map(|f| (f.world_from_laser, f.scan))
+        .collect())
 }
 
 /// Files in `dir` whose names end with `suffix`, sorted.
@@ -47,8 +48,9 @@ pub fn log_name(path: &Path) -> String {
     name.split("-corrected").next().unwrap_or(&name).to_owned()
 }
 
-/// One 3-D scan: `world_from_velodyne` (REP-103 world: z up) and its rays in the sensor
-/// frame (every `ray_step`-th valid point).
+/// One 3-D scan: `world_from_velodyne` (the REP-103 world of [`SweepSequence`]: the
+/// velodyne frame of the first scan) and its rays in the sensor frame (every
+/// `ray_step`-th valid point).
 pub struct Scan3 {
     /// `world_from_velodyne` in a z-up world frame.
     pub pose: Pose3,
@@ -56,33 +58,21 @@ pub struct Scan3 {
     pub rays: Vec<Ray3>,
 }
 
-/// Frames `0..frames` of KITTI sequence `dir` (a `sequences/XX` directory); frame `f`
-/// keeps every `ray_step(f)`-th point as a ray.
+/// Sweeps `0..frames` of KITTI sequence `dir` (a `sequences/XX` directory) with their
+/// reference poses; sweep `f` keeps every `ray_step(f)`-th point as a ray.
 pub fn kitti_scans(
     dir: &Path,
     frames: usize,
     ray_step: impl Fn(usize) -> usize,
     mut progress: impl FnMut(),
 ) -> Result<Vec<Scan3>> {
-    let sequence = KittiSequence::open(dir)?;
-    let cam_poses = sequence.poses()?;
-    let Some(calib) = sequence.calib()? else {
-        bail!("{}: no calib.txt", dir.display());
-    };
-    let Some(cam0_from_velo) = calib.cam0_from_velo() else {
-        bail!("{}: calib.txt has no Tr entry", dir.display());
-    };
-    let flu = flu_from_camera();
-    let poses: Vec<Pose3> = velodyne_poses(&cam_poses, &cam0_from_velo)
-        .into_iter()
-        .map(|p| flu * p)
-        .collect();
+    let sequence = SweepSequence::open(dir, &SweepOptions::default())?;
+    let poses = sequence.require_reference()?;
     let mut scans = Vec::new();
     for (frame, pose) in poses.iter().enumerate().take(frames) {
-        let Some(cloud) = sequence.scan(frame as u64) else {
-            bail!("{}: no velodyne scan for frame {frame}", dir.display());
-        };
-        let cloud = cloud.with_context(|| format!("frame {frame}"))?;
+        let cloud = sequence
+            .sweep(frame)
+            .with_context(|| format!("frame {frame}"))?;
         let rays = (0..cloud.len())
             .step_by(ray_step(frame).max(1))
             .filter(|&i| cloud.is_valid(i))
