@@ -1,8 +1,19 @@
 //! # raypath-io
 //!
-//! Readers for the files lidar users have — CARMEN logs, KITTI and NCLT sequences, PCD point
-//! clouds, OctoMap trees and scan graphs, SegComp range images, plain `x y z` text — and
-//! writers where round trips matter (PCD, OctoMap ScanGraph).
+//! Readers for the files lidar users have — CARMEN logs, KITTI and NCLT sequences, ROS 2 bags
+//! (rosbag2 with MCAP storage), PCD point clouds, OctoMap trees and scan graphs, SegComp range
+//! images, plain `x y z` text — and writers where round trips matter (PCD, OctoMap, CARMEN,
+//! KITTI, rosbag2), plus Foxglove recordings of results.
+//!
+//! * **One way in.** [`sequence`] is how every command and evaluation reads a log or a
+//!   sequence: timestamped planar scans with odometry and reference poses
+//!   ([`sequence::open_planar`]: CARMEN logs, bags with `sensor_msgs/msg/LaserScan`) and
+//!   timestamped 3-D sweeps with sensor poses ([`sequence::SweepSequence`]: KITTI, NCLT, bags
+//!   with `sensor_msgs/msg/PointCloud2`). Raw-to-corrected log pairing lives there too.
+//! * **ROS 2 and Foxglove.** [`rosbag`] reads and writes rosbag2 MCAP bags with no ROS
+//!   installation (own CDR decoder; the message types and what is ignored are listed there);
+//!   [`foxglove`] writes results as an MCAP that Foxglove opens with no plugin; [`convert`]
+//!   turns CARMEN logs, KITTI sequences and PCD files into bags and back.
 //!
 //! * **Streaming.** Logs and packet streams are read record by record through iterators;
 //!   a 100 MB log never sits in memory whole. gzip and bzip2 are recognized by their first
