@@ -2,6 +2,7 @@
 //!
 //! ```text
 //! raypath info <path> [--json] [--format <name>]
+//! raypath convert <in> <out> [--to carmen|kitti|pcd|rosbag2] [--json]
 //! raypath simulate <kind> --out DIR [--seed S] [--quick] [--scans N] [--json]
 //! raypath simulate semi-kitti --poses poses.txt --times times.txt --poles poles.csv --out DIR
 //! ```
@@ -33,43 +34,48 @@ enum Command {
     /// Detect a file's format and summarize it: scans, beams, points, poses, odometry,
     /// organized size, labels, bounding box, time span. A KITTI or NCLT directory is one input.
     Info(commands::info::Args),
+    /// Convert between CARMEN logs, the KITTI layout, PCD files and rosbag2 (MCAP) bags.
+    Convert(commands::convert::Args),
     /// Generate simulated data in real formats (CARMEN, PCD, KITTI, NCLT): polygons, indoor
     /// worlds, the 1-D corridor, SynPEB-style rooms, urban drives, semi-synthetic KITTI.
     Simulate(commands::simulate::Args),
-    /// Build a map from a CARMEN log (corrected poses) or a 3-D sequence: per-cell ray
-    /// statistics and a decay-rate, reflection or log-odds model (PGM+YAML and binary map).
+    /// Build a map from a CARMEN log (corrected poses), a 3-D sequence or a rosbag2 bag:
+    /// per-cell ray statistics and a decay-rate, reflection or log-odds model (PGM+YAML and
+    /// binary map).
     Map(commands::map::Args),
-    /// Score every sensor model on a corrected CARMEN log: negative log-likelihood at the true
-    /// poses and inverse KL over poses in a disc (Schaefer Table 7.3, Table 8.2/8.3 ratios).
+    /// Score every sensor model on a corrected CARMEN log or a bag with reference poses:
+    /// negative log-likelihood at the true poses and inverse KL over poses in a disc
+    /// (Schaefer Table 7.3, Table 8.2/8.3 ratios).
     ScoreModel(commands::score_model::Args),
-    /// Monte-Carlo localization of a log in a map written by `raypath map`; with ground truth,
-    /// the error summary.
+    /// Monte-Carlo localization of a log (CARMEN or rosbag2) in a map written by `raypath map`;
+    /// with ground truth, the error summary.
     Localize(commands::localize::Args),
-    /// Extract polylines from the scans of a CARMEN log: maximum-likelihood PLE / PLE+
+    /// Extract polylines from the scans of a CARMEN log or a bag: maximum-likelihood PLE / PLE+
     /// (Schaefer ch. 10) or the VVL, IEF, SAM baselines; vertices, RMSE, f, optional SVG.
     Polylines(commands::polylines::Args),
-    /// Extract finite planes from an organized PCD scan (PPE, Schaefer ch. 11): labels per
-    /// point and per plane its normal, distance, point count and RMSE.
+    /// Extract finite planes from an organized PCD scan or a bag's organized PointCloud2 (PPE,
+    /// Schaefer ch. 11): labels per point and per plane its normal, distance, point count and
+    /// RMSE.
     Planes(commands::planes::Args),
     /// Score a segmentation against ground-truth labels (Hoover et al., T = 0.8): f, k and
     /// the over-, under-segmented, missed and noise counts.
     SegcompEval(commands::segcomp_eval::Args),
-    /// Build the Rtree variable-resolution occupancy grid (Khan ch. 2) from a scan graph or
-    /// sequence: nodes, leaves, bytes, times.
+    /// Build the Rtree variable-resolution occupancy grid (Khan ch. 2) from a scan graph, a
+    /// sequence or a bag: nodes, leaves, bytes, times.
     Octree(commands::octree::Args),
     /// Pole extraction, pole maps and pole-based particle-filter localization (Schaefer ch. 12).
     Poles(commands::poles::Args),
     /// Fit a continuous DCT decay-rate map (Schaefer ch. 9) and a grid map with as many
-    /// parameters from the same rays, and score both.
+    /// parameters from the same rays (a CARMEN log or a bag), and score both.
     DctMap(commands::dct_map::Args),
-    /// Hector-style scan matching of a CARMEN log with occupancy, reflectivity or combined
-    /// residuals (Khan ch. 3): trajectory, map, speed and errors.
+    /// Hector-style scan matching of a CARMEN log or a bag with occupancy, reflectivity or
+    /// combined residuals (Khan ch. 3): trajectory, map, speed and errors.
     ScanMatch(commands::scan_match::Args),
     /// Fit the intensity look-up table I_ref(r, α) from reference-surface samples (Khan ch. 3).
     CalibrateIntensity(commands::calibrate_intensity::Args),
     /// Loop-closure detection (IBuILD, Khan ch. 4) or kidnapped-robot place recognition on a
-    /// CARMEN log, KITTI sequence or image folder; with ground truth, the precision–recall
-    /// summary.
+    /// CARMEN log, KITTI sequence, NCLT session, rosbag2 bag or image folder; with ground
+    /// truth, the precision–recall summary.
     LoopClosure(commands::loop_closure::Args),
 }
 
@@ -77,6 +83,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Info(args) => commands::info::run(args),
+        Command::Convert(args) => commands::convert::run(args),
         Command::Simulate(args) => commands::simulate::run(args),
         Command::Map(args) => commands::map::run(args),
         Command::ScoreModel(args) => commands::score_model::run(args),

@@ -162,6 +162,54 @@ fn extract_map_and_localize() {
 }
 
 #[test]
+fn a_bag_gives_the_poles_of_its_sequence() {
+    use raypath_io::rosbag::{BagWriteOptions, write_sweeps};
+    use raypath_io::sequence::{SweepOptions, SweepSequence};
+
+    let tmp = tempfile::tempdir().unwrap();
+    let seq = write_drive(tmp.path(), 12);
+    let bag = tmp.path().join("drive.mcap");
+    let sweeps = SweepSequence::open(&seq, &SweepOptions::default()).unwrap();
+    write_sweeps(&bag, &sweeps, &BagWriteOptions::default()).unwrap();
+    let from_seq = json_of(&raypath(&[
+        "poles",
+        "extract",
+        seq.to_str().unwrap(),
+        "--json",
+    ]));
+    let from_bag = json_of(&raypath(&[
+        "poles",
+        "extract",
+        bag.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(from_bag["preset"], "kitti");
+    assert_eq!(from_seq["scans"], from_bag["scans"]);
+    let (a, b) = (
+        from_seq["poles"].as_array().unwrap(),
+        from_bag["poles"].as_array().unwrap(),
+    );
+    assert!(!a.is_empty());
+    assert_eq!(a.len(), b.len());
+    for (p, q) in a.iter().zip(b) {
+        for key in ["x", "y", "width"] {
+            let (u, v) = (p[key].as_f64().unwrap(), q[key].as_f64().unwrap());
+            assert!((u - v).abs() < 1e-6, "{key}: {u} vs {v}");
+        }
+    }
+    // A topic the bag does not have is bad input naming it.
+    let out = raypath(&[
+        "poles",
+        "extract",
+        bag.to_str().unwrap(),
+        "--cloud-topic",
+        "/nope",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nope"));
+}
+
+#[test]
 fn a_kitti_root_with_one_sequence_is_that_sequence() {
     let tmp = tempfile::tempdir().unwrap();
     let seq = write_drive(&tmp.path().join("sequences"), 12);

@@ -10,7 +10,9 @@ use super::Failure;
 #[derive(clap::Args)]
 pub struct Args {
     /// A file (CARMEN log, PCD, OctoMap .bt/.graph, xyz text, KITTI/NCLT file, SegComp file,
-    /// point CSV; plain, .gz or .bz2) or a KITTI sequence / NCLT session directory.
+    /// point CSV; plain, .gz or .bz2), a KITTI sequence / NCLT session directory, or a rosbag2
+    /// bag (its directory with metadata.yaml, or its .mcap file: topics, types, counts, rates,
+    /// time span).
     pub path: PathBuf,
     /// Print one JSON object (keys: format, scans, beams, points, poses, odometry, width,
     /// height, labels, bbox, time_span, nodes, and format-specific entries).
@@ -104,7 +106,9 @@ pub fn render_text(path: &std::path::Path, s: &Summary) -> String {
         );
     }
     for (key, value) in &s.extra {
-        push(&key.replace('_', " "), render_value(value));
+        if key != "topics" {
+            push(&key.replace('_', " "), render_value(value));
+        }
     }
     let width = lines
         .iter()
@@ -112,10 +116,59 @@ pub fn render_text(path: &std::path::Path, s: &Summary) -> String {
         .max()
         .unwrap_or(0)
         + 1;
-    lines
+    let mut text: String = lines
         .iter()
         .map(|(k, v)| format!("{:<width$}  {v}\n", format!("{k}:")))
-        .collect()
+        .collect();
+    if let Some(serde_json::Value::Array(topics)) = s.extra.get("topics") {
+        text.push_str(&render_topics(topics));
+    }
+    text
+}
+
+/// A bag's topics as a table: name, type, messages, rate, first and last log time.
+fn render_topics(topics: &[serde_json::Value]) -> String {
+    let rows: Vec<[String; 5]> = topics
+        .iter()
+        .map(|t| {
+            let text = |key: &str| t[key].as_str().unwrap_or("").to_owned();
+            let number = |key: &str, digits: usize| {
+                t[key]
+                    .as_f64()
+                    .map_or_else(|| "-".to_owned(), |v| format!("{v:.digits$}"))
+            };
+            [
+                text("name"),
+                text("type"),
+                t["message_count"].to_string(),
+                number("rate_hz", 2),
+                format!("{} to {}", number("first_secs", 3), number("last_secs", 3)),
+            ]
+        })
+        .collect();
+    let header = ["topic", "type", "messages", "rate Hz", "log time s"];
+    let widths: Vec<usize> = (0..5)
+        .map(|c| {
+            rows.iter()
+                .map(|r| r[c].chars().count())
+                .chain([header[c].len()])
+                .max()
+                .unwrap_or(0)
+        })
+        .collect();
+    let line = |cells: [&str; 5]| {
+        let mut out = String::from(" ");
+        for (c, cell) in cells.iter().enumerate() {
+            out.push_str(&format!(" {cell:<w$}", w = widths[c]));
+        }
+        out.trim_end().to_owned() + "\n"
+    };
+    let mut out = format!("topics ({}):\n", rows.len());
+    out.push_str(&line(header));
+    for r in &rows {
+        out.push_str(&line([&r[0], &r[1], &r[2], &r[3], &r[4]]));
+    }
+    out
 }
 
 /// A JSON value as text: strings bare, flat arrays and objects as lists, nested ones as JSON.

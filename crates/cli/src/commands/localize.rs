@@ -1,33 +1,45 @@
-//! `raypath localize`: Monte-Carlo localization of a 2-D CARMEN log on a map written by
+//! `raypath localize`: Monte-Carlo localization of a 2-D log on a map written by
 //! `raypath map`.
 //!
 //! The map file (`raypath_sensor_models::export::binary`) holds per-cell statistics and
 //! names a sensor model; the command builds that model (or `--model-override`), reads the
-//! log's laser scans and odometry (`world_from_robot` of each scan message: wheel odometry
-//! in a raw log, corrected poses in a corrected log; only increments are used), and runs the
-//! particle filter of `raypath_localizer` (`lidar::track_planar`). With `--ground-truth` (a
-//! corrected CARMEN log or a TUM pose file `t x y z qx qy qz qw`) it evaluates the estimates
-//! every 1 m of ground-truth path and prints the error summary.
+//! log's laser scans and odometry through `raypath_io::sequence` (a CARMEN log, `--laser`
+//! front by default, or a rosbag2 bag's LaserScan topic with its odometry; the robot's
+//! `world_from_robot` of each scan: wheel odometry in a raw log, corrected poses in a
+//! corrected log; only increments are used), and runs the particle filter of
+//! `raypath_localizer` (`lidar::track_planar`). With `--ground-truth` (a corrected CARMEN log,
+//! a bag — its reference poses, else its logged poses — or a TUM pose file `t x y z qx qy qz
+//! qw`) it evaluates the estimates every 1 m of ground-truth path and prints the error
+//! summary.
 //!
 //! Initial particles: Gaussian (σ 1 m, 0.1 rad) around `--initial`, else the ground truth
 //! at the first scan, else the log's first pose (right for corrected logs).
+//!
+//! `--record OUT.mcap` writes a Foxglove recording (see `record`): the map's picture values as
+//! the `FLOAT32` Grid `/map` (at the first scan's time), every estimated scan at the estimate
+//! (`/tf` `map → base_link`, `/scan` in `base_link`), the estimates as `/trajectory` and the
+//! ground truth as `/ground_truth`.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use raypath_geometry::Pose2;
-use raypath_io::carmen::CarmenReader;
+use raypath_io::foxglove::{GridValues, topic};
+use raypath_io::sequence::PlanarFrame;
 use raypath_localizer::eval::{EvaluationConfig, evaluate_trajectory};
 use raypath_localizer::init::GaussianInit;
 use raypath_localizer::lidar::{
     LidarConfig, ModelKind, ModelSpec, PlanarStep, Scan2Measurement, TrackConfig, track_planar,
 };
 use raypath_localizer::{PoseTrack, Stamped};
+use raypath_sensor_models::DenseStats2;
 use raypath_sensor_models::OpticalDepthConfig;
-use raypath_sensor_models::export::{MapFile, MapKind, StoredStats};
+use raypath_sensor_models::export::{MapFile, MapKind, MapPicture, StoredStats, picture_values};
 use serde_json::json;
 
 use super::Failure;
+use super::record::{RecordArgs, Recording};
+use super::source_args::{SourceArgs, is_bag, reference_track};
 
 /// Largest gap between a ground-truth stamp and a scan stamp that pairs them (the corrected
 /// CARMEN logs print the raw logger stamp with fewer digits), seconds.
@@ -39,10 +51,12 @@ pub struct Args {
     /// The binary map written by `raypath map` (2-D).
     #[arg(long, value_name = "M")]
     pub map: PathBuf,
-    /// A CARMEN log with laser scans and odometry (raw, or corrected).
+    /// A CARMEN log with laser scans and odometry (raw, or corrected), or a rosbag2 bag
+    /// (directory with metadata.yaml, or .mcap file) with LaserScan and odometry.
     #[arg(long, value_name = "L")]
     pub log: PathBuf,
-    /// Ground truth: a corrected CARMEN log or a TUM pose file, matched by time.
+    /// Ground truth: a corrected CARMEN log, a bag (its reference poses) or a TUM pose file,
+    /// matched by time.
     #[arg(long, value_name = "G")]
     pub ground_truth: Option<PathBuf>,
     /// Number of particles.
@@ -73,25 +87,12 @@ pub struct Args {
     /// Print one JSON document on standard output.
     #[arg(long)]
     pub json: bool,
-}
-
-/// One scan of the log: stamp, odometry pose, laser pose, scan.
-type LogScan = (f64, Pose2, Pose2, raypath_geometry::Scan2);
-
-fn read_log(path: &Path, json: bool) -> Result<Vec<LogScan>, Failure> {
-    let reader = CarmenReader::open(path).map_err(|e| Failure::input(e, json))?;
-    reader
-        .front_lasers()
-        .map(|m| {
-            let m = m.map_err(|e| Failure::input(e, json))?;
-            Ok((
-                m.logger_timestamp_secs,
-                m.world_from_robot,
-                m.world_from_laser,
-                m.scan,
-            ))
-        })
-        .collect()
+    /// How to read the log and the ground truth.
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// A Foxglove recording of the run.
+    #[command(flatten)]
+    pub record: RecordArgs,
 }
 
 /// Reads a TUM file `t x y z qx qy qz qw` (through `raypath_io::tum`), keeping x, y and the
@@ -138,28 +139,45 @@ fn internal(error: impl std::fmt::Display, json: bool) -> Failure {
     }
 }
 
-/// The ground truth as `(stamp, world_from_robot)`, strictly increasing in time.
+/// The ground truth as `(stamp, world_from_robot)`, strictly increasing in time: the
+/// reference poses of a planar source (a bag, or a CARMEN log with laser scans), else a TUM
+/// file.
 fn read_ground_truth(
     path: &Path,
+    source: &SourceArgs,
     robot_from_laser: Pose2,
     json: bool,
 ) -> Result<Vec<(f64, Pose2)>, Failure> {
-    let carmen = CarmenReader::open(path).ok().and_then(|reader| {
-        let out: Vec<(f64, Pose2)> = reader
-            .front_lasers()
-            .map(|m| {
-                m.map(|m| {
-                    (
-                        m.logger_timestamp_secs,
-                        m.world_from_laser * robot_from_laser.inverse(),
-                    )
-                })
-            })
-            .collect::<Result<_, _>>()
-            .ok()?;
-        (!out.is_empty()).then_some(out)
-    });
-    let mut poses = match carmen {
+    let to_robot = |frames: Vec<PlanarFrame>| -> Vec<(f64, Pose2)> {
+        let track = reference_track(&frames);
+        frames
+            .iter()
+            .zip(track)
+            .filter_map(|(f, pose)| Some((f.stamp_secs, pose? * robot_from_laser.inverse())))
+            .collect()
+    };
+    let planar = if is_bag(path) {
+        let poses = to_robot(
+            source
+                .read_frames(path)
+                .map_err(|e| Failure::input(e, json))?,
+        );
+        if poses.is_empty() {
+            return Err(Failure::input(
+                format!("{}: no poses", path.display()),
+                json,
+            ));
+        }
+        Some(poses)
+    } else {
+        // Not a CARMEN log with laser scans: a TUM file.
+        source
+            .read_frames(path)
+            .ok()
+            .map(to_robot)
+            .filter(|poses| !poses.is_empty())
+    };
+    let mut poses = match planar {
         Some(poses) => poses,
         None => read_tum(path, json)?,
     };
@@ -188,6 +206,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         .as_deref()
         .map(|t| parse_initial(t, json))
         .transpose()?;
+    let mut recording = Recording::open(&args.record, json)?;
     let map = MapFile::read_file(&args.map).map_err(|e| Failure::input(e, json))?;
     let StoredStats::Planar(stats) = &map.stats else {
         return Err(Failure::input(
@@ -218,18 +237,21 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         .build(stats, map.mapping.range)
         .map_err(|e| Failure::input(format!("{}: {e}", args.map.display()), json))?;
 
-    let scans = read_log(&args.log, json)?;
+    let scans = args
+        .source
+        .read_frames(&args.log)
+        .map_err(|e| Failure::input(e, json))?;
     let Some(first) = scans.first() else {
         return Err(Failure::input(
             format!("{}: no laser scans", args.log.display()),
             json,
         ));
     };
-    let robot_from_laser = first.1.inverse() * first.2;
+    let robot_from_laser = first.robot_from_laser();
     let ground_truth = args
         .ground_truth
         .as_deref()
-        .map(|g| read_ground_truth(g, robot_from_laser, json))
+        .map(|g| read_ground_truth(g, &args.source, robot_from_laser, json))
         .transpose()?;
 
     let gt_stamps: Vec<f64> = ground_truth.iter().flatten().map(|g| g.0).collect();
@@ -240,13 +262,15 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             .filter_map(|&j| gt_stamps.get(j))
             .any(|s| (s - t).abs() <= MATCH_TOLERANCE_SECS)
     };
+    let first_stamp = first.stamp_secs;
+    let first_odometry = first.world_from_robot;
     let steps: Vec<PlanarStep> = scans
-        .iter()
-        .map(|(t, odom, _, scan)| PlanarStep {
-            stamp_secs: *t,
-            odom_from_robot: *odom,
-            scan: scan.clone(),
-            force_update: near_truth(*t),
+        .into_iter()
+        .map(|f| PlanarStep {
+            stamp_secs: f.stamp_secs,
+            odom_from_robot: f.world_from_robot,
+            force_update: near_truth(f.stamp_secs),
+            scan: f.scan,
         })
         .collect();
     let truth_track = match &ground_truth {
@@ -268,9 +292,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     };
     let start = initial.unwrap_or_else(|| match &truth_track {
         Some(track) => track
-            .pose_at(first.0)
-            .unwrap_or_else(|_| track.poses().first().copied().unwrap_or(first.1)),
-        None => first.1,
+            .pose_at(first_stamp)
+            .unwrap_or_else(|_| track.poses().first().copied().unwrap_or(first_odometry)),
+        None => first_odometry,
     });
     let lidar = LidarConfig {
         beam_step: args.beam_step,
@@ -314,7 +338,22 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         ),
         None => None,
     };
-    let summary = json!({
+    if let Some(recording) = &mut recording {
+        let truth = truth_track
+            .as_ref()
+            .map(PoseTrack::poses)
+            .unwrap_or_default();
+        record(
+            recording,
+            stats,
+            map.kind,
+            &steps,
+            &result.estimates,
+            robot_from_laser,
+            truth,
+        )?;
+    }
+    let mut summary = json!({
         "map": args.map.display().to_string(),
         "log": args.log.display().to_string(),
         "model": spec.label(),
@@ -340,6 +379,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         })),
     });
     if json {
+        super::record::finish(recording, Some(&mut summary))?;
         println!("{summary:#}");
     } else {
         println!(
@@ -365,6 +405,54 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                 100.0 * e.divergence.fraction_of_time
             );
         }
+        super::record::finish(recording, None)?;
+    }
+    Ok(())
+}
+
+/// `--record`: the map at the first scan's time, each estimated scan at its estimate, the
+/// estimated trajectory and the ground truth.
+fn record(
+    recording: &mut Recording,
+    stats: &DenseStats2,
+    kind: MapKind,
+    steps: &[PlanarStep],
+    estimates: &[(usize, Stamped<Pose2>)],
+    robot_from_laser: Pose2,
+    truth: &[Pose2],
+) -> Result<(), Failure> {
+    let (picture, field) = match kind {
+        MapKind::Reflection => (MapPicture::Reflection, "reflection"),
+        MapKind::LogOdds | MapKind::LikelihoodField => (MapPicture::Occupancy, "occupancy"),
+        MapKind::Statistics | MapKind::DecayRate => (MapPicture::DecayRate, "hit_probability"),
+    };
+    let values: Vec<f32> = picture_values(stats, picture)
+        .into_iter()
+        .map(|v| v.map_or(f32::NAN, |v| v as f32))
+        .collect();
+    let start = steps.first().map_or(0.0, |s| s.stamp_secs);
+    recording.grid(
+        topic::MAP,
+        start,
+        stats.grid(),
+        field,
+        GridValues::F32(&values),
+    )?;
+    for (i, estimate) in estimates {
+        if let Some(step) = steps.get(*i) {
+            recording.planar_scan(
+                estimate.stamp_secs,
+                &estimate.pose,
+                &robot_from_laser,
+                &step.scan,
+            )?;
+        }
+    }
+    let end = recording.end_stamp();
+    let poses: Vec<Pose2> = estimates.iter().map(|(_, s)| s.pose).collect();
+    recording.planar_trajectory(topic::TRAJECTORY, end, &poses)?;
+    if !truth.is_empty() {
+        recording.planar_trajectory(topic::GROUND_TRUTH, end, truth)?;
     }
     Ok(())
 }

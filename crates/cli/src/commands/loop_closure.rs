@@ -1,6 +1,8 @@
 //! `raypath loop-closure`: loop-closure detection (IBuILD, Khan 2017, §4.4) or place
-//! recognition without temporal consistency (Khan 2017, §4.5) on a CARMEN log (front-laser
-//! scans), a KITTI sequence directory (velodyne scans) or a folder of PNG/JPEG images (sorted
+//! recognition without temporal consistency (Khan 2017, §4.5) on a CARMEN log (the laser
+//! `--laser`, front by default), a KITTI sequence or NCLT session directory (velodyne scans), a
+//! rosbag2 bag (LaserScan or PointCloud2; its directory with `metadata.yaml` or its `.mcap`
+//! file) — these read through `raypath_io::sequence` — or a folder of PNG/JPEG images (sorted
 //! by file name), with the methods of `raypath_place_recognition`: `ibuild` (default), `dbow`,
 //! `scan-context`, `hog`, `gist`, `shot`, `polar`. Methods that cannot describe the input's
 //! frames (Scan Context and SHOT need point clouds, the polar descriptor planar scans) fail
@@ -16,7 +18,7 @@
 //!   a best candidate with a score of at least `--min-score`, with no temporal test.
 //!
 //! `--ground-truth FILE` (a CARMEN corrected log — the input log itself when it is one —, a
-//! KITTI `poses.txt` or a TUM file `t x y z qx qy qz qw`) adds the precision–recall summary:
+//! bag with reference poses, a KITTI `poses.txt` or a TUM file `t x y z qx qy qz qw`) adds the precision–recall summary:
 //! same place = less than `--radius` metres apart (default 2 m with overlapping fields of view
 //! for planar scans, 5 m otherwise), pairs closer than `--exclusion-frames` frames or
 //! `--exclusion-seconds` seconds are not evaluated. Pairing of poses and frames: see `truth`.
@@ -30,15 +32,25 @@
 //! "score"}], "candidates": [{"query", "match", "score"}]}` plus `"summary":
 //! {"recall_at_100_precision", "precision_at_100_recall", "max_f1"}` with ground truth.
 //! `candidates` holds, for every query with any hypothesis, its best match (higher score =
-//! more similar). Frame numbers are 0-based in input order (front-laser scans for CARMEN,
-//! frame numbers for KITTI). `ms_per_query` is the mean time to describe, query and insert a
+//! more similar). Frame numbers are 0-based in input order (laser scans for CARMEN and bags,
+//! sweeps for NCLT and bags, frame numbers for KITTI). `ms_per_query` is the mean time to describe, query and insert a
 //! frame.
+//!
+//! `--record OUT.mcap` writes a Foxglove recording (see `record`) of the frames' poses — the
+//! ground truth paired with them when `--ground-truth` is given, else the input's own
+//! (reference, else logged or odometry) poses; an image folder without ground truth has none
+//! —: `/tf` `map → base_link` at each posed frame's time (frame index as seconds when the
+//! frames have no times), the poses as `/trajectory`, and the accepted loop closures as a
+//! line list between the matched frames' positions on `/loops`.
 
 mod input;
 mod truth;
 
 use std::path::PathBuf;
 
+use nalgebra::Point3;
+use raypath_geometry::Pose3;
+use raypath_io::foxglove::{frame, topic};
 use raypath_place_recognition::{
     BinaryVocabulary, Candidate, Dbow, DbowConfig, Exclusion, FrameTiming, GlobalDescriptorDb,
     GroundTruth, Ibuild, IbuildConfig, IbuildScore, KidnappedRun, LoopClosure, LoopConfig,
@@ -51,6 +63,8 @@ use serde_json::json;
 use self::input::{Input, read_input};
 use self::truth::{TruthParams, ground_truth};
 use super::Failure;
+use super::record::{RecordArgs, Recording, loop_lines};
+use super::source_args::SourceArgs;
 
 /// Place-recognition methods.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -83,7 +97,8 @@ pub enum Mode {
 /// Arguments of `raypath loop-closure`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// A CARMEN log, a KITTI sequence directory or a folder of PNG/JPEG images.
+    /// A CARMEN log, a KITTI sequence or NCLT session directory, a rosbag2 bag (directory
+    /// with metadata.yaml, or .mcap file) or a folder of PNG/JPEG images.
     pub input: PathBuf,
     /// The place-recognition method.
     #[arg(long, value_enum, default_value_t = Method::Ibuild)]
@@ -91,7 +106,8 @@ pub struct Args {
     /// Online loop closure or kidnapped-robot place recognition.
     #[arg(long, value_enum, default_value_t = Mode::Online)]
     pub mode: Mode,
-    /// Ground-truth poses: CARMEN (corrected) log, KITTI poses.txt or TUM file.
+    /// Ground-truth poses: CARMEN (corrected) log, bag with reference poses, KITTI poses.txt
+    /// or TUM file.
     #[arg(long, value_name = "POSES")]
     pub ground_truth: Option<PathBuf>,
     /// DBoW vocabulary file (without it, dbow trains one on the input, with a warning).
@@ -145,6 +161,12 @@ pub struct Args {
     /// Print one JSON document on standard output.
     #[arg(long)]
     pub json: bool,
+    /// How to read the input and the ground truth.
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// A Foxglove recording of the run.
+    #[command(flatten)]
+    pub record: RecordArgs,
 }
 
 /// What a run produced.
@@ -194,7 +216,8 @@ fn check_args(args: &Args) -> Result<(), Failure> {
 /// Runs `raypath loop-closure`.
 pub fn run(args: &Args) -> Result<(), Failure> {
     check_args(args)?;
-    let input = read_input(&args.input, args.max_frames, args.json)?;
+    let mut recording = Recording::open(&args.record, args.json)?;
+    let input = read_input(&args.input, &args.source, args.max_frames, args.json)?;
     let truth = match &args.ground_truth {
         None => None,
         Some(path) => {
@@ -208,7 +231,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                     seconds: args.exclusion_seconds,
                 },
             };
-            Some((path, ground_truth(path, &input, &params, args.json)?))
+            Some((
+                path,
+                ground_truth(path, &args.source, &input, &params, args.json)?,
+            ))
         }
     };
     let outcome = dispatch(args, &input)?;
@@ -217,15 +243,66 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let loops = detect_loops(&config, &outcome.candidates).map_err(place)?;
     let summary = match &truth {
         None => None,
-        Some((_, gt)) => Some(evaluate(args, &config, &outcome, gt).map_err(place)?),
+        Some((_, (gt, _))) => Some(evaluate(args, &config, &outcome, gt).map_err(place)?),
     };
+    if let Some(recording) = &mut recording {
+        let poses = match &truth {
+            Some((_, (_, paired))) => Some(paired.as_slice()),
+            None => input.poses.as_deref(),
+        };
+        record(recording, &input, poses.unwrap_or_default(), &loops)?;
+    }
     if args.json {
-        println!("{}", to_json(&input, &outcome, &loops, summary.as_ref()));
+        let mut doc = to_json(&input, &outcome, &loops, summary.as_ref());
+        super::record::finish(recording, Some(&mut doc))?;
+        println!("{doc}");
     } else {
-        let truth_info = truth.as_ref().map(|(p, gt)| (p.as_path(), gt, summary));
+        let truth_info = truth
+            .as_ref()
+            .map(|(p, (gt, _))| (p.as_path(), gt, summary));
         print_text(args, &input, &outcome, &loops, truth_info);
+        super::record::finish(recording, None)?;
     }
     Ok(())
+}
+
+/// `--record`: `/tf` at each frame with a pose (at its time, else its index in seconds), the
+/// poses as `/trajectory`, and the loops between posed frames as segments on `/loops`.
+fn record(
+    recording: &mut Recording,
+    input: &Input,
+    poses: &[Option<Pose3>],
+    loops: &[LoopClosure],
+) -> Result<(), Failure> {
+    let stamp = |i: usize| {
+        input
+            .times
+            .as_ref()
+            .and_then(|t| t.get(i).copied())
+            .unwrap_or(i as f64)
+    };
+    let mut trajectory = Vec::with_capacity(poses.len());
+    for (i, pose) in poses.iter().enumerate() {
+        if let Some(pose) = pose.filter(Pose3::is_finite) {
+            recording.robot_pose(stamp(i), &pose)?;
+            trajectory.push(pose);
+        }
+    }
+    let end = recording.end_stamp();
+    recording.trajectory(topic::TRAJECTORY, end, &trajectory)?;
+    let position = |i: usize| {
+        poses
+            .get(i)
+            .copied()
+            .flatten()
+            .filter(Pose3::is_finite)
+            .map(|p| Point3::from(p.translation()))
+    };
+    let pairs: Vec<(Point3<f64>, Point3<f64>)> = loops
+        .iter()
+        .filter_map(|l| Some((position(l.query)?, position(l.matched)?)))
+        .collect();
+    recording.scene(topic::LOOPS, end, frame::MAP, &loop_lines(&pairs))
 }
 
 fn evaluate(

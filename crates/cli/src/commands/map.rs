@@ -4,19 +4,26 @@
 //! raypath map <log-or-sequence> --model decay-rate|reflection|log-odds [--posterior]
 //!             --resolution R --out PREFIX [--json]
 //!             [--max-range M] [--min-range M] [--ray-step N] [--skip-no-returns] [--sparse]
+//!             [--laser front|rear|any] [--scan-topic T] [--cloud-topic T] [--odom-topic T]
+//!             [--reference-topic T] [--frame F] [--record OUT.mcap]
 //! ```
 //!
-//! Inputs:
-//! * a CARMEN log (plain, gzip or bzip2) with corrected poses: every laser message's
-//!   `world_from_laser` pose is trusted as ground truth → a 2-D map;
-//! * a KITTI-layout sequence directory (`velodyne/*.bin` + `poses.txt`, or the benchmark
-//!   layout `sequences/NN` + `poses/NN.txt`): camera-0 poses are turned into velodyne poses
-//!   with `Tr` of `calib.txt` (without `calib.txt` the poses are taken as velodyne poses) →
-//!   a 3-D map;
-//! * an NCLT session directory (`velodyne_sync/*.bin` + `groundtruth_<date>.csv`): every
-//!   revolution gets the ground-truth pose nearest in time (REP-103 body frame; the points
-//!   are turned from x-forward/y-right/z-down to x-forward/y-left/z-up; the small
-//!   body-to-velodyne offset is ignored) → a 3-D map.
+//! The input is read through the sources of `raypath_io::sequence`:
+//! * planar scans → a 2-D map: a CARMEN log (plain, gzip or bzip2; `--laser` picks the
+//!   laser, front by default) whose laser poses are trusted as ground truth (a corrected
+//!   log), or a rosbag2 bag's `sensor_msgs/msg/LaserScan` topic at its reference poses
+//!   (`--reference-topic`), else at its odometry poses;
+//! * 3-D sweeps → a 3-D map at their reference poses (else the odometry, with a warning): a
+//!   KITTI-layout sequence directory (`velodyne/*.bin` + `poses.txt` + `calib.txt`, or the
+//!   benchmark layout `sequences/NN` + `poses/NN.txt`; camera-0 poses are turned into
+//!   velodyne poses with `Tr`), an NCLT session directory (`velodyne_sync/*.bin` +
+//!   `groundtruth_<date>.csv`, the ground truth interpolated at the scan times; points and
+//!   poses in REP-103 axes; the small body-to-velodyne offset is ignored), or a bag's
+//!   `sensor_msgs/msg/PointCloud2` topic.
+//!
+//! A bag (its directory with `metadata.yaml`, or its `.mcap` file) gives a 2-D map from its
+//! LaserScan topic, or a 3-D map from its PointCloud2 topic when it has no LaserScan topic or
+//! `--cloud-topic` is given.
 //!
 //! The grid covers the sensor positions and all returns within the maximum range, plus one
 //! cell. Outputs: `PREFIX.pgm` + `PREFIX.yaml` (ROS `map_server`; a 3-D map is shown as its
@@ -24,8 +31,16 @@
 //! `raypath_sensor_models::export`, read by `raypath localize`; it records the model and the
 //! posterior flag). Pictures show the ML map value (reflection probability, decay-rate hit
 //! probability over one cell, or log-odds occupancy).
+//!
+//! `--record OUT.mcap` writes a Foxglove recording (see `record`): 2-D — every scan at its
+//! pose (`/tf`, `/scan`), the robot's trajectory and the map's picture values as a `FLOAT32`
+//! Grid `/map` (NaN = unknown); 3-D — every sweep at its pose (`/tf`, `/points` thinned by
+//! `record::sweep_points`), the trajectory, the column-sum picture as `/map` and the
+//! centres of the occupied voxels (value above one half) as the PointCloud `/map_points` (at
+//! most `map::record::MAX_VOXELS`).
 
 mod input;
+mod record;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -39,6 +54,8 @@ use raypath_sensor_models::{
 };
 
 use super::Failure;
+use super::record::{RecordArgs, Recording};
+use super::source_args::SourceArgs;
 use input::{Input, Sweep3};
 
 /// The sensor model a map is built for.
@@ -82,7 +99,8 @@ impl Model {
 #[derive(clap::Args)]
 pub struct Args {
     /// A CARMEN log with corrected poses (2-D), a KITTI sequence directory or an NCLT
-    /// session directory (3-D).
+    /// session directory (3-D), or a rosbag2 bag (directory with metadata.yaml, or .mcap
+    /// file): LaserScan (2-D) or PointCloud2 (3-D).
     pub input: PathBuf,
     /// The sensor model the map is for.
     #[arg(long, value_enum)]
@@ -117,6 +135,12 @@ pub struct Args {
     /// Print one JSON document on standard output.
     #[arg(long)]
     pub json: bool,
+    /// How to read the input.
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// A Foxglove recording of the run.
+    #[command(flatten)]
+    pub record: RecordArgs,
 }
 
 /// Largest dense map `raypath map` allocates (cells); 16 bytes per cell.
@@ -126,11 +150,12 @@ const MAX_CELLS: usize = 200_000_000;
 pub fn run(args: &Args) -> Result<(), Failure> {
     let started = Instant::now();
     let config = check_args(args)?;
-    let input = Input::read(&args.input, args.ray_step, &config)
+    let mut recording = Recording::open(&args.record, args.json)?;
+    let input = Input::read(&args.input, &args.source, args.ray_step, &config)
         .map_err(|e| Failure::input(e, args.json))?;
     let mapping_started = Instant::now();
     let (stats, dims) = match &input {
-        Input::Planar { scans, bounds } => {
+        Input::Planar { scans, bounds, .. } => {
             let grid = raypath_geometry::Grid2::covering(bounds, args.resolution)
                 .map_err(|e| grid_failure(args, e))?;
             check_size(args, grid.num_cells())?;
@@ -143,7 +168,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             });
             (StoredStats::Planar(stats), 2)
         }
-        Input::Spatial { sweeps, bounds } => {
+        Input::Spatial { sweeps, bounds, .. } => {
             let grid = raypath_geometry::Grid3::covering(bounds, args.resolution)
                 .map_err(|e| grid_failure(args, e))?;
             check_size(args, grid.num_cells())?;
@@ -170,11 +195,17 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         stats,
     };
     let written = write_outputs(args, &file)?;
+    if let Some(recording) = &mut recording {
+        record::record(recording, &input, &file, args.model.picture())?;
+    }
     let report = Report::of(args, &file, dims, mapping_secs, started, written);
     if args.json {
-        println!("{}", report.json());
+        let mut doc = report.json();
+        super::record::finish(recording, Some(&mut doc))?;
+        println!("{doc}");
     } else {
         report.print();
+        super::record::finish(recording, None)?;
     }
     Ok(())
 }

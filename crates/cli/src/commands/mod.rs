@@ -1,6 +1,7 @@
 //! One module per subcommand, plus the shared failure type.
 
 pub mod calibrate_intensity;
+pub mod convert;
 pub mod dct_map;
 pub mod info;
 pub mod localize;
@@ -10,10 +11,12 @@ pub mod octree;
 pub mod planes;
 pub mod poles;
 pub mod polylines;
+pub mod record;
 pub mod scan_match;
 pub mod score_model;
 pub mod segcomp_eval;
 pub mod simulate;
+pub mod source_args;
 
 use std::process::ExitCode;
 

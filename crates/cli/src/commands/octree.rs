@@ -1,10 +1,13 @@
 //! `raypath octree`: the Rtree variable-resolution occupancy grid (Khan 2017, ch. 2) built
-//! from a scan graph, a KITTI sequence or a single `x y z` scan.
+//! from a scan graph, a 3-D sequence or a single `x y z` scan.
 //!
 //! Inputs: an OctoMap ScanGraph (`.graph`, points in the sensor frame with a pose per scan),
-//! a KITTI odometry sequence directory (velodyne scans, poses and `calib.txt`; poses are
-//! turned into a REP-103 world frame), or a point list (`x y z` per line, optionally
-//! compressed, sensor at the origin — OctoMap's `scan.dat`).
+//! a sequence read through `raypath_io::sequence::SweepSequence` — a KITTI odometry sequence
+//! directory (velodyne scans, poses and `calib.txt`; the world frame is the velodyne frame of
+//! the first scan, REP-103 axes), an NCLT session directory, or a rosbag2 bag's PointCloud2
+//! topic (its directory with `metadata.yaml`, or its `.mcap` file) — at its reference poses,
+//! else its odometry, or a point list (`x y z` per line, optionally compressed, sensor at the
+//! origin — OctoMap's `scan.dat`).
 //!
 //! Prints nodes, leaves, bytes and times; `--json` prints one object with the keys
 //! `input`, `scans`, `points`, `resolution_m`, `model`, `fusion`, `fusion_interval_scans`,
@@ -17,22 +20,34 @@
 //! an unfused grid at every base cube.
 //! `--out FILE` writes the map: `.bt` as an OctoMap tree at the base resolution, `.ply` as a
 //! mesh of the occupied cuboids.
+//!
+//! `--record OUT.mcap` writes a Foxglove recording (see `record`): `/tf` `map → base_link` at
+//! each scan's pose and time (sequences: their scan times; scan graphs and point files: the
+//! scan index as seconds), the sensor `/trajectory`, the centres of all occupied leaves as the
+//! PointCloud `/map_points` (intensity: occupancy probability), and the occupied leaves as
+//! cubes on `/octree` — at most [`MAX_CUBES`], the largest first (a cube is about 200 bytes of
+//! JSON). The scans themselves are not recorded.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use nalgebra::Point3;
 use raypath_geometry::{PointCloud, Pose3};
-use raypath_io::kitti::KittiSequence;
+use raypath_io::foxglove::{frame, topic};
 use raypath_io::octomap::read_graph;
-use raypath_rtree_grid::{FusionRule, GridConfig, RtreeGrid, SensorModel};
+use raypath_rtree_grid::{Cuboid, FusionRule, GridConfig, RtreeGrid, SensorModel};
 use serde_json::json;
 
 use super::Failure;
+use super::record::{RecordArgs, Recording, cube_entities};
+use super::source_args::{SourceArgs, is_bag, sweep_poses};
 
 /// Arguments of `raypath octree`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// A `.graph` scan graph, a KITTI sequence directory or an `x y z` point file.
+    /// A `.graph` scan graph, a KITTI sequence or NCLT session directory, a rosbag2 bag
+    /// (directory with metadata.yaml, or .mcap file) with PointCloud2, or an `x y z` point
+    /// file.
     pub input: PathBuf,
     /// Base resolution r, metres.
     #[arg(long, value_name = "R")]
@@ -66,57 +81,65 @@ pub struct Args {
     /// Print one JSON document on standard output.
     #[arg(long)]
     pub json: bool,
+    /// How to read a bag.
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// A Foxglove recording of the run.
+    #[command(flatten)]
+    pub record: RecordArgs,
 }
 
-/// The scans as `(world_from_sensor, points in the sensor frame)`.
-fn load(args: &Args) -> Result<Vec<(Pose3, PointCloud)>, Failure> {
+/// Most occupied leaves recorded as cubes on `/octree` (the largest first).
+pub const MAX_CUBES: usize = 20_000;
+
+/// Scans as `(world_from_sensor, points in the sensor frame)`.
+type Scans = Vec<(Pose3, PointCloud)>;
+
+/// The scans with their times: a sequence's scan times, else the scan index as seconds.
+fn load(args: &Args) -> Result<(Scans, Vec<f64>), Failure> {
     let bad = |e: raypath_io::Error| Failure::input(e, args.json);
     let path = &args.input;
     let limit = args.scans.unwrap_or(usize::MAX);
-    if path.is_dir() {
-        let sequence = KittiSequence::open(path).map_err(bad)?;
-        let poses = sequence.poses().map_err(bad)?;
-        let calib = sequence.calib().map_err(bad)?.ok_or_else(|| {
-            Failure::input(
-                format!("{}: the KITTI sequence has no calib.txt", path.display()),
-                args.json,
-            )
-        })?;
-        let cam0_from_velo = calib.cam0_from_velo().ok_or_else(|| {
-            Failure::input(
+    let indices = |n: usize| (0..n).map(|i| i as f64).collect();
+    if path.is_dir() || is_bag(path) {
+        let sequence = args.source.open_sweeps(path).map_err(bad)?;
+        let Some((poses, _)) = sweep_poses(&sequence) else {
+            return Err(Failure::input(
                 format!(
-                    "{}: calib.txt has no Tr (velodyne to camera)",
-                    path.display()
+                    "{}: no sensor poses (reference or odometry)",
+                    sequence.name.display()
                 ),
                 args.json,
-            )
-        })?;
-        let flu = raypath_io::kitti::flu_from_camera();
+            ));
+        };
         let mut scans = Vec::new();
-        for file in sequence.scan_files.iter().take(limit) {
-            let pose = poses.get(file.frame as usize).ok_or_else(|| {
-                Failure::input(
-                    format!("{}: no pose for frame {}", path.display(), file.frame),
-                    args.json,
-                )
-            })?;
-            let cloud = raypath_io::kitti::read_velodyne(&file.path).map_err(bad)?;
-            scans.push((flu * *pose * cam0_from_velo, cloud));
+        for (i, pose) in poses.iter().enumerate().take(limit) {
+            scans.push((*pose, sequence.sweep(i).map_err(bad)?));
         }
-        return Ok(scans);
+        let mut stamps: Vec<f64> = indices(scans.len());
+        for (stamp, t) in stamps.iter_mut().zip(&sequence.stamps_secs) {
+            *stamp = *t;
+        }
+        return Ok((scans, stamps));
     }
     let name = path.to_string_lossy();
-    if name.ends_with(".graph") || name.ends_with(".graph.gz") || name.ends_with(".graph.bz2") {
+    let scans: Scans = if name.ends_with(".graph")
+        || name.ends_with(".graph.gz")
+        || name.ends_with(".graph.bz2")
+    {
         let graph = read_graph(path).map_err(bad)?;
-        return Ok(graph
+        graph
             .nodes
             .into_iter()
             .take(limit)
             .map(|n| (n.world_from_sensor, n.points))
-            .collect());
-    }
-    let cloud = raypath_io::xyz::read_xyz(path).map_err(bad)?;
-    Ok(vec![(Pose3::identity(), cloud)])
+            .collect()
+    } else {
+        let cloud = raypath_io::xyz::read_xyz(path).map_err(bad)?;
+        vec![(Pose3::identity(), cloud)]
+    };
+    let stamps = indices(scans.len());
+    Ok((scans, stamps))
 }
 
 fn write_map(grid: &RtreeGrid, out: &Path, json: bool) -> Result<(), Failure> {
@@ -181,7 +204,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     config.fusion_rule = fusion_rule;
     config.fusion_interval_scans = args.fusion_interval;
     let mut grid = RtreeGrid::new(config).map_err(|e| Failure::input(e, args.json))?;
-    let scans = load(args)?;
+    let mut recording = Recording::open(&args.record, args.json)?;
+    let (scans, stamps) = load(args)?;
     let points: usize = scans.iter().map(|(_, c)| c.num_valid()).sum();
     let started = Instant::now();
     for (pose, cloud) in &scans {
@@ -199,9 +223,12 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     if let Some(out) = &args.out {
         write_map(&grid, out, args.json)?;
     }
+    if let Some(recording) = &mut recording {
+        record(recording, &grid, &scans, &stamps)?;
+    }
     let per_point_us = insert_secs / points.max(1) as f64 * 1e6;
     if args.json {
-        let doc = json!({
+        let mut doc = json!({
             "input": args.input.display().to_string(),
             "scans": scans.len(),
             "points": points,
@@ -223,6 +250,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "access_secs": access_secs,
             "out": args.out.as_ref().map(|p| p.display().to_string()),
         });
+        super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
     } else {
         println!(
@@ -251,6 +279,48 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         if let Some(out) = &args.out {
             println!("wrote {}", out.display());
         }
+        super::record::finish(recording, None)?;
     }
     Ok(())
+}
+
+/// `--record`: the sensor poses (`/tf`, `/trajectory`), the occupied leaves' centres
+/// (`/map_points`) and the largest [`MAX_CUBES`] occupied leaves as cubes (`/octree`).
+fn record(
+    recording: &mut Recording,
+    grid: &RtreeGrid,
+    scans: &[(Pose3, PointCloud)],
+    stamps: &[f64],
+) -> Result<(), Failure> {
+    for ((pose, _), stamp) in scans.iter().zip(stamps) {
+        recording.robot_pose(*stamp, pose)?;
+    }
+    let end = recording.end_stamp();
+    let poses: Vec<Pose3> = scans.iter().map(|(pose, _)| *pose).collect();
+    recording.trajectory(topic::TRAJECTORY, end, &poses)?;
+    let mut occupied: Vec<Cuboid> = Vec::new();
+    grid.for_each_cuboid(|c| {
+        if c.occupied {
+            occupied.push(*c);
+        }
+    });
+    let center = |c: &Cuboid| {
+        let m = |a: usize| ((c.min_m[a] + c.max_m[a]) / 2.0) as f32;
+        Point3::new(m(0), m(1), m(2))
+    };
+    let mut cloud = PointCloud::from_points(occupied.iter().map(center).collect());
+    cloud.intensity = Some(occupied.iter().map(|c| c.probability as f32).collect());
+    recording.points(topic::MAP_POINTS, end, frame::MAP, &cloud, None)?;
+    if occupied.len() > MAX_CUBES {
+        eprintln!(
+            "note: --record: {} occupied leaves; /octree holds the {MAX_CUBES} largest as cubes, \
+             /map_points the centres of all",
+            occupied.len()
+        );
+        let volume = |c: &Cuboid| (0..3).map(|a| c.max_m[a] - c.min_m[a]).product::<f64>();
+        occupied.sort_by(|a, b| volume(b).total_cmp(&volume(a)));
+        occupied.truncate(MAX_CUBES);
+    }
+    let entities = cube_entities(&occupied, "occupied leaves");
+    recording.scene(topic::OCTREE, end, frame::MAP, &entities)
 }

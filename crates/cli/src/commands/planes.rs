@@ -1,6 +1,11 @@
 //! `raypath planes`: maximum-likelihood finite planes (PPE; Schaefer 2020 ch. 11) from an
 //! organized PCD scan, in the sensor frame (every ray starts at the origin).
 //!
+//! The scan is a PCD file, or one sweep of a rosbag2 bag (its directory with
+//! `metadata.yaml`, or its `.mcap` file): sweep `--frame-index` (default 0) of its
+//! `sensor_msgs/msg/PointCloud2` topic, read through `raypath_io::sequence::SweepSequence`;
+//! the cloud must be organized (height > 1, NaN = no return).
+//!
 //! `--method ppe|msac|peac` picks PPE (default), the iterative MSAC baseline or the
 //! PEAC-style block-graph baseline (Feng et al. 2014); `--preset` applies to PPE (the
 //! baselines use their SynPEB parameters).
@@ -12,22 +17,37 @@
 //! `--json` prints `{"planes": [{"label", "normal": [x, y, z], "distance", "points",
 //! "rmse"}, …]}` plus `scan`, `width`, `height`, `method`, `preset`, `rmse` (all planes,
 //! per point) and `seconds` (extraction time).
+//!
+//! `--record OUT.mcap` writes a Foxglove recording (see `record`) at the sweep's time (a PCD
+//! file: time 0): `/tf` `map → base_link` (the identity: the sensor at the origin), the scan
+//! as the PointCloud `/points` in `base_link` with a `label` field (0 = no plane, planes
+//! `1..=J`) and coloured by label (grey: no plane), and per plane an entity `plane <label>` on
+//! `/planes`: the outline of its points' convex hull on the fitted plane, filled with
+//! half-transparent triangles of the same colour.
 
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
+use raypath_geometry::{PointCloud, Pose3};
+use raypath_io::foxglove::{Rgba, frame, topic};
 use raypath_io::pcd::{ReadOptions, read_pcd};
-use raypath_planes::{MsacParams, PeacParams, PpeParams, extract, msac, peac};
+use raypath_planes::{MsacParams, PeacParams, PpeParams, Segmentation, extract, msac, peac};
 use serde_json::json;
 
 use super::Failure;
+use super::record::{RecordArgs, Recording, label_color, plane_entity};
+use super::source_args::{SourceArgs, is_bag};
 
 /// Arguments of `raypath planes`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// An organized PCD scan (width × height, NaN = no return).
+    /// An organized PCD scan (width × height, NaN = no return), or a rosbag2 bag (directory
+    /// with metadata.yaml, or .mcap file) with organized PointCloud2.
     pub scan: PathBuf,
+    /// Bags: the 0-based index of the sweep to use.
+    #[arg(long, default_value_t = 0, value_name = "I")]
+    pub frame_index: usize,
     /// Extraction method: ppe (default), msac or peac.
     #[arg(long, default_value = "ppe", value_name = "NAME")]
     pub method: String,
@@ -47,6 +67,103 @@ pub struct Args {
     /// Print one JSON document on standard output.
     #[arg(long)]
     pub json: bool,
+    /// How to read a bag.
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// A Foxglove recording of the run.
+    #[command(flatten)]
+    pub record: RecordArgs,
+}
+
+/// The organized scan and its time: a PCD file (time 0), or sweep `--frame-index` of a bag.
+fn read_scan(args: &Args) -> Result<(PointCloud, f64), Failure> {
+    let bad = |e: raypath_io::Error| Failure::input(e, args.json);
+    if !is_bag(&args.scan) {
+        let options = ReadOptions {
+            label_from: raypath_io::pcd::LabelSource::None,
+        };
+        return Ok((read_pcd(&args.scan, &options).map_err(bad)?.cloud, 0.0));
+    }
+    let sequence = args.source.open_sweeps(&args.scan).map_err(bad)?;
+    if args.frame_index >= sequence.len() {
+        return Err(Failure::input(
+            format!(
+                "{}: --frame-index {} but the bag has {} sweep(s)",
+                sequence.name.display(),
+                args.frame_index,
+                sequence.len()
+            ),
+            args.json,
+        ));
+    }
+    let cloud = sequence.sweep(args.frame_index).map_err(bad)?;
+    if !cloud.is_organized() {
+        return Err(Failure::input(
+            format!(
+                "{}: sweep {} is not organized ({} × {} points); plane extraction needs a \
+                 range image (PointCloud2 with height > 1)",
+                sequence.name.display(),
+                args.frame_index,
+                cloud.width,
+                cloud.height
+            ),
+            args.json,
+        ));
+    }
+    let stamp = sequence
+        .stamps_secs
+        .get(args.frame_index)
+        .copied()
+        .unwrap_or(0.0);
+    Ok((cloud, stamp))
+}
+
+/// Points without a plane: grey.
+const NO_PLANE: Rgba = [0.6, 0.6, 0.6, 1.0];
+
+/// `--record`: the sensor at the origin, the cloud labelled and coloured by plane, and the
+/// planes' outlines and fills.
+fn record(
+    recording: &mut Recording,
+    stamp: f64,
+    cloud: &PointCloud,
+    seg: &Segmentation,
+) -> Result<(), Failure> {
+    recording.robot_pose(stamp, &Pose3::identity())?;
+    let mut labelled = cloud.clone();
+    let labels: Vec<u32> = (0..cloud.len())
+        .map(|i| seg.labels.get(i).copied().flatten().map_or(0, |l| l + 1))
+        .collect();
+    let colors: Vec<Rgba> = labels
+        .iter()
+        .map(|&l| match l {
+            0 => NO_PLANE,
+            l => label_color(l as usize),
+        })
+        .collect();
+    labelled.label = Some(labels);
+    recording.points(
+        topic::POINTS,
+        stamp,
+        frame::BASE_LINK,
+        &labelled,
+        Some(&colors),
+    )?;
+    let entities: Vec<_> = seg
+        .planes
+        .iter()
+        .enumerate()
+        .filter_map(|(i, plane)| {
+            let points: Vec<_> = plane
+                .index
+                .iter()
+                .filter(|&&k| k < cloud.len())
+                .map(|&k| cloud.point_f64(k))
+                .collect();
+            plane_entity(i + 1, &points, &plane.fit.normal(), plane.fit.distance_m())
+        })
+        .collect();
+    recording.scene(topic::PLANES, stamp, frame::BASE_LINK, &entities)
 }
 
 /// Runs the command.
@@ -76,11 +193,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             args.json,
         ));
     }
-    let options = ReadOptions {
-        label_from: raypath_io::pcd::LabelSource::None,
-    };
-    let pcd = read_pcd(&args.scan, &options).map_err(|e| Failure::input(e, args.json))?;
-    let cloud = pcd.cloud;
+    let mut recording = Recording::open(&args.record, args.json)?;
+    let (cloud, stamp) = read_scan(args)?;
     let started = Instant::now();
     let result = match args.method.as_str() {
         "msac" | "peac" => {
@@ -114,6 +228,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             json: args.json,
         })?;
     }
+    if let Some(recording) = &mut recording {
+        record(recording, stamp, &cloud, &seg)?;
+    }
     if args.json {
         let planes: Vec<_> = seg
             .planes
@@ -125,9 +242,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                        "points": p.index.len(), "rmse": p.fit.rmse_m()})
             })
             .collect();
-        let doc = json!({"scan": args.scan.display().to_string(), "width": cloud.width,
+        let mut doc = json!({"scan": args.scan.display().to_string(), "width": cloud.width,
             "height": cloud.height, "method": args.method, "preset": args.preset, "planes": planes,
             "rmse": seg.rmse_m(), "seconds": seconds});
+        super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
     } else {
         println!(
@@ -153,6 +271,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                 p.fit.rmse_m()
             );
         }
+        super::record::finish(recording, None)?;
     }
     Ok(())
 }

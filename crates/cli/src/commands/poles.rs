@@ -1,5 +1,9 @@
 //! `raypath poles extract|map|localize`: pole extraction, pole maps and pole-based
-//! localization (Schaefer 2020, ch. 12) on a sequence in KITTI or NCLT layout.
+//! localization (Schaefer 2020, ch. 12) on a sequence in KITTI or NCLT layout, or a rosbag2
+//! bag's PointCloud2 topic (its directory with `metadata.yaml`, or its `.mcap` file; topics by
+//! `--cloud-topic`, `--odom-topic`, `--reference-topic`, `--frame`), read through
+//! `raypath_poles::Drive` on `raypath_io::sequence::SweepSequence` (a bag follows KITTI's
+//! conventions: the kitti preset, odometry noise as for KITTI when it has no odometry).
 //!
 //! * `extract <sequence>`: the poles of one local map built from the registered scans of the
 //!   first trajectory segment from `--from` (ground-truth poses; odometry when the sequence
@@ -16,6 +20,14 @@
 //! "local_maps", "poles": [{x, y, width, height, score}], "points_per_sec"}`; `localize` →
 //! `{"sequence", "preset", "runs", "summary": {mean_pos_m, rmse_pos_m, mean_lat_m,
 //! mean_lon_m, mean_ang_deg, rmse_ang_deg, diverged_runs}, "per_run": […]}`.
+//!
+//! `--record OUT.mcap` writes a Foxglove recording (see `record`): `extract`/`map` — each scan
+//! used at its mapping pose and time (`/tf` `map → base_link`, its points on `/points`, thinned
+//! by `record::sweep_points`), the mapping `/trajectory` and the poles as cylinders on
+//! `/poles`; `localize` — the map's poles on `/poles`, each scan at its estimate in the first
+//! run (`/tf`, `/points`), that run's `/trajectory` and the ground truth as `/ground_truth`.
+
+mod record;
 
 use std::path::PathBuf;
 
@@ -29,6 +41,8 @@ use raypath_poles::{
 use serde_json::json;
 
 use super::Failure;
+use super::record::{RecordArgs, Recording};
+use super::source_args::SourceArgs;
 
 /// Arguments of `raypath poles`.
 #[derive(clap::Args)]
@@ -52,7 +66,8 @@ pub enum Command {
 /// Options shared by the subcommands.
 #[derive(clap::Args)]
 pub struct Common {
-    /// A KITTI sequence directory or an NCLT session directory.
+    /// A KITTI sequence directory, an NCLT session directory or a rosbag2 bag (directory with
+    /// metadata.yaml, or .mcap file) with PointCloud2.
     pub sequence: PathBuf,
     /// Parameter preset: nclt or kitti (default: from the layout).
     #[arg(long, value_name = "NAME")]
@@ -66,6 +81,12 @@ pub struct Common {
     /// Print one JSON document on standard output.
     #[arg(long)]
     pub json: bool,
+    /// How to read a bag.
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// A Foxglove recording of the run.
+    #[command(flatten)]
+    pub record: RecordArgs,
 }
 
 /// Arguments of `raypath poles extract`.
@@ -131,7 +152,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
 
 fn open(common: &Common) -> Result<(Drive, Preset, std::ops::Range<usize>), Failure> {
     let json = common.json;
-    let drive = Drive::open(&common.sequence).map_err(|e| Failure::input(e, json))?;
+    let drive = Drive::open_with(&common.sequence, &common.source.sweep_options())
+        .map_err(|e| Failure::input(e, json))?;
     let preset = match common.preset.as_deref() {
         Some("nclt") => Preset::nclt(),
         Some("kitti") => Preset::kitti(),
@@ -206,6 +228,7 @@ fn mapping_track(drive: &Drive) -> Vec<Pose3> {
 fn extract(args: &ExtractArgs) -> Result<(), Failure> {
     let c = &args.common;
     let (drive, preset, range) = open(c)?;
+    let mut recording = Recording::open(&c.record, c.json)?;
     let track = mapping_track(&drive);
     let (maps, totals) = local_maps(&drive, &track, range.clone(), &preset, |_, _| {})
         .map_err(|e| Failure::input(e, c.json))?;
@@ -214,18 +237,21 @@ fn extract(args: &ExtractArgs) -> Result<(), Failure> {
     if let Some(out) = &args.out {
         write_pole_csv(out, &poles).map_err(|e| Failure::input(e, c.json))?;
     }
+    if let Some(recording) = &mut recording {
+        let used = maps.first().map(|m| m.scans.clone()).unwrap_or_default();
+        record::mapping(recording, &drive, &track, &used, &poles, c.json)?;
+    }
     if c.json {
-        println!(
-            "{}",
-            json!({
-                "sequence": c.sequence.display().to_string(),
-                "preset": preset_name(c, &drive),
-                "scans": scans,
-                "local_maps": maps.len().min(1),
-                "poles": poles_json(&poles),
-                "points_per_sec": totals.points_per_sec(),
-            })
-        );
+        let mut doc = json!({
+            "sequence": c.sequence.display().to_string(),
+            "preset": preset_name(c, &drive),
+            "scans": scans,
+            "local_maps": maps.len().min(1),
+            "poles": poles_json(&poles),
+            "points_per_sec": totals.points_per_sec(),
+        });
+        super::record::finish(recording, Some(&mut doc))?;
+        println!("{doc}");
     } else {
         println!(
             "{}: {} poles from {scans} scans ({:.2} M points/s)",
@@ -234,6 +260,7 @@ fn extract(args: &ExtractArgs) -> Result<(), Failure> {
             totals.points_per_sec() / 1e6
         );
         print_poles(&poles);
+        super::record::finish(recording, None)?;
     }
     Ok(())
 }
@@ -241,25 +268,29 @@ fn extract(args: &ExtractArgs) -> Result<(), Failure> {
 fn map(args: &MapArgs) -> Result<(), Failure> {
     let c = &args.common;
     let (drive, preset, range) = open(c)?;
+    let mut recording = Recording::open(&c.record, c.json)?;
     let track = mapping_track(&drive);
     let scans = range.len();
-    let (maps, totals) = local_maps(&drive, &track, range, &preset, |_, _| {})
+    let (maps, totals) = local_maps(&drive, &track, range.clone(), &preset, |_, _| {})
         .map_err(|e| Failure::input(e, c.json))?;
     let poles = reference_map(&maps, &preset);
     write_pole_csv(&args.out, &poles).map_err(|e| Failure::input(e, c.json))?;
+    if let Some(recording) = &mut recording {
+        let used: Vec<usize> = range.collect();
+        record::mapping(recording, &drive, &track, &used, &poles, c.json)?;
+    }
     if c.json {
-        println!(
-            "{}",
-            json!({
-                "sequence": c.sequence.display().to_string(),
-                "preset": preset_name(c, &drive),
-                "scans": scans,
-                "local_maps": maps.len(),
-                "poles": poles_json(&poles),
-                "points_per_sec": totals.points_per_sec(),
-                "out": args.out.display().to_string(),
-            })
-        );
+        let mut doc = json!({
+            "sequence": c.sequence.display().to_string(),
+            "preset": preset_name(c, &drive),
+            "scans": scans,
+            "local_maps": maps.len(),
+            "poles": poles_json(&poles),
+            "points_per_sec": totals.points_per_sec(),
+            "out": args.out.display().to_string(),
+        });
+        super::record::finish(recording, Some(&mut doc))?;
+        println!("{doc}");
     } else {
         println!(
             "{}: {} map poles from {} local maps over {scans} scans ({:.2} M points/s) → {}",
@@ -269,6 +300,7 @@ fn map(args: &MapArgs) -> Result<(), Failure> {
             totals.points_per_sec() / 1e6,
             args.out.display()
         );
+        super::record::finish(recording, None)?;
     }
     Ok(())
 }
@@ -287,6 +319,7 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
         .filter
         .validate()
         .map_err(|e| Failure::input(e, json))?;
+    let mut recording = Recording::open(&c.record, json)?;
     let map = read_pole_csv(&args.map).map_err(|e| Failure::input(e, json))?;
     if map.is_empty() {
         return Err(Failure::input(
@@ -347,6 +380,11 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
             args.seed + r as u64,
         )
         .map_err(|e| Failure::input(e, json))?;
+        if r == 0
+            && let Some(recording) = &mut recording
+        {
+            record::localization(recording, &drive, range.clone(), &map, &track, json)?;
+        }
         if let Some(last) = track.poses().last() {
             finals.push(json!({"x": last.x(), "y": last.y(), "theta": last.theta()}));
         }
@@ -378,6 +416,7 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
         // No ground truth: report the final estimates only.
         if json {
             answer["final_poses"] = finals.into();
+            super::record::finish(recording, Some(&mut answer))?;
             println!("{answer}");
         } else {
             println!(
@@ -386,6 +425,7 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
                 args.runs,
                 serde_json::Value::from(finals)
             );
+            super::record::finish(recording, None)?;
         }
         return Ok(());
     }
@@ -404,6 +444,7 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
             .collect();
         answer["summary"] = summary;
         answer["per_run"] = per_run.into();
+        super::record::finish(recording, Some(&mut answer))?;
         println!("{answer}");
     } else {
         println!(
@@ -416,6 +457,7 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
             "{}",
             serde_json::to_string_pretty(&summary).unwrap_or_default()
         );
+        super::record::finish(recording, None)?;
     }
     Ok(())
 }

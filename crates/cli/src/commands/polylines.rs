@@ -1,5 +1,9 @@
 //! `raypath polylines`: maximum-likelihood polylines (PLE, PLE+; Schaefer 2020 ch. 10) or a
-//! baseline (VVL, IEF, SAM) from the scans of a CARMEN log, in the scan frame.
+//! baseline (VVL, IEF, SAM) from the scans of a CARMEN log or a rosbag2 bag, in the scan
+//! frame.
+//!
+//! The scans are read through `raypath_io::sequence`: the laser `--laser` of a CARMEN log
+//! (front by default), or a bag's LaserScan topic; indices count these scans from 0.
 //!
 //! Prints per scan the vertices, the RMSE of the ray radii and the fraction `f` of reflected
 //! rays the polylines explain; `--svg FILE` draws scan and polylines (one file per scan,
@@ -10,22 +14,30 @@
 //! polylines) plus the top-level keys `log`, `method`, `optimizer`, `max_vertices`,
 //! `max_edge_m`, `removed_residual_m` and `closed` (per scan, per polyline: whether it is a
 //! closed polygon, whose last vertex connects back to the first).
+//!
+//! `--record OUT.mcap` writes a Foxglove recording (see `record`): per processed scan, at its
+//! stamp, `/tf` `map → base_link` (the logged robot pose), the `/scan` LaserScan in `base_link`
+//! (with the laser's mounting) and its polylines as line strips (polygons as loops) on
+//! `/polylines`, one entity that the next scan's replaces.
 
 use std::path::{Path, PathBuf};
 
-use raypath_geometry::Scan2;
-use raypath_io::carmen::{CarmenReader, Record};
+use raypath_io::foxglove::{frame, topic};
+use raypath_io::sequence::PlanarFrame;
 use raypath_polylines::metrics::ray_metrics;
 use raypath_polylines::svg::scan_svg;
 use raypath_polylines::{Method, Optimizer, PolylineConfig, Polylines, extract};
 use serde_json::json;
 
 use super::Failure;
+use super::record::{RecordArgs, Recording, polyline_entities};
+use super::source_args::SourceArgs;
 
 /// Arguments of `raypath polylines`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// A CARMEN log (plain, .gz or .bz2).
+    /// A CARMEN log (plain, .gz or .bz2), or a rosbag2 bag (directory with metadata.yaml, or
+    /// .mcap file) with LaserScan.
     pub log: PathBuf,
     /// Comma-separated 0-based indices of the laser scans to process (default: the first).
     #[arg(
@@ -62,6 +74,12 @@ pub struct Args {
     /// Print one JSON document on standard output.
     #[arg(long)]
     pub json: bool,
+    /// How to read the log.
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// A Foxglove recording of the run.
+    #[command(flatten)]
+    pub record: RecordArgs,
 }
 
 /// One processed scan.
@@ -116,8 +134,8 @@ fn config(args: &Args) -> Result<PolylineConfig, Failure> {
     Ok(config)
 }
 
-/// The selected scans `(index, scan)`, read until the last one needed.
-fn read_scans(args: &Args) -> Result<Vec<(usize, Scan2)>, Failure> {
+/// The selected scans `(index, frame)`, read until the last one needed.
+fn read_scans(args: &Args) -> Result<Vec<(usize, PlanarFrame)>, Failure> {
     let mut wanted: Vec<usize> = if args.scans.is_empty() {
         vec![0]
     } else {
@@ -126,18 +144,20 @@ fn read_scans(args: &Args) -> Result<Vec<(usize, Scan2)>, Failure> {
     wanted.sort_unstable();
     wanted.dedup();
     let last = wanted.last().copied().unwrap_or(0);
-    let reader = CarmenReader::open(&args.log).map_err(|e| Failure::input(e, args.json))?;
+    let source = args
+        .source
+        .open_planar(&args.log)
+        .map_err(|e| Failure::input(e, args.json))?;
     let mut scans = Vec::new();
     let mut index = 0usize;
-    for record in reader {
-        if let Record::Laser(laser) = record.map_err(|e| Failure::input(e, args.json))? {
-            if args.all || wanted.binary_search(&index).is_ok() {
-                scans.push((index, laser.scan));
-            }
-            index += 1;
-            if !args.all && index > last {
-                break;
-            }
+    for frame in source {
+        let frame = frame.map_err(|e| Failure::input(e, args.json))?;
+        if args.all || wanted.binary_search(&index).is_ok() {
+            scans.push((index, frame));
+        }
+        index += 1;
+        if !args.all && index > last {
+            break;
         }
     }
     if !args.all && index <= last {
@@ -166,10 +186,12 @@ fn svg_path(base: &Path, index: usize, several: bool) -> PathBuf {
 /// Runs `raypath polylines`.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let config = config(args)?;
+    let mut recording = Recording::open(&args.record, args.json)?;
     let scans = read_scans(args)?;
     let several = scans.len() > 1;
     let mut results = Vec::with_capacity(scans.len());
-    for (index, scan) in &scans {
+    for (index, frame) in &scans {
+        let scan = &frame.scan;
         let place = || format!("{}: scan {index}", args.log.display());
         let map = extract(scan, &config)
             .map_err(|e| Failure::input(format!("{}: {e}", place()), args.json))?;
@@ -183,6 +205,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                 json: args.json,
             })?;
         }
+        if let Some(recording) = &mut recording {
+            record(recording, frame, &map)?;
+        }
         results.push(Extracted {
             index: *index,
             map,
@@ -191,11 +216,32 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         });
     }
     if args.json {
-        println!("{}", to_json(args, &config, &results));
+        let mut doc = to_json(args, &config, &results);
+        super::record::finish(recording, Some(&mut doc))?;
+        println!("{doc}");
     } else {
         print_text(args, &config, &results);
+        super::record::finish(recording, None)?;
     }
     Ok(())
+}
+
+/// `--record`: the scan where it was logged and its polylines, in `base_link`.
+fn record(recording: &mut Recording, frame: &PlanarFrame, map: &Polylines) -> Result<(), Failure> {
+    let robot_from_laser = frame.robot_from_laser();
+    recording.planar_scan(
+        frame.stamp_secs,
+        &frame.world_from_robot,
+        &robot_from_laser,
+        &frame.scan,
+    )?;
+    let entities = polyline_entities(map, &robot_from_laser, "polylines");
+    recording.scene(
+        topic::POLYLINES,
+        frame.stamp_secs,
+        frame::BASE_LINK,
+        &entities,
+    )
 }
 
 fn to_json(args: &Args, config: &PolylineConfig, results: &[Extracted]) -> serde_json::Value {

@@ -1,27 +1,37 @@
 //! `raypath scan-match`: Hector-style multi-resolution scan matching (Khan 2017 ch. 3) of the
-//! front-laser scans of a CARMEN log, with the occupancy, reflectivity or combined residual.
+//! scans of a CARMEN log (the laser `--laser`, front by default) or of a rosbag2 bag's
+//! LaserScan topic, with the occupancy, reflectivity or combined residual. The scans and
+//! their logged poses (the odometry of `--odometry`) are read through `raypath_io::sequence`.
 //!
 //! Outputs: `--out FILE` the trajectory in TUM format (`t x y z qx qy qz qw`, t = each scan's
-//! IPC timestamp, the first timestamp of its CARMEN line; poses of the sensor in the map
-//! frame, which starts at the first scan); `--map PREFIX` the finest occupancy level as
-//! `PREFIX.pgm` + `PREFIX.yaml` (ROS map_server) and, when the map has reflectivity,
-//! `PREFIX-reflectivity.png`; `--ground-truth LOG` scores the trajectory against a
-//! corrected log (scans paired by identical readings): relative-motion error over consecutive
+//! IPC timestamp, the first timestamp of its CARMEN line, or a bag message's header stamp;
+//! poses of the sensor in the map frame, which starts at the first scan); `--map PREFIX` the
+//! finest occupancy level as `PREFIX.pgm` + `PREFIX.yaml` (ROS map_server) and, when the map
+//! has reflectivity, `PREFIX-reflectivity.png`; `--ground-truth LOG` scores the trajectory
+//! against a corrected log or a bag with reference poses (scans paired by identical readings
+//! with `raypath_io::sequence::pair_by_ranges`): relative-motion error over consecutive
 //! reference scans (Kümmerle et al. 2009) and the error after rigid alignment;
-//! `--corrected-log FILE` a copy of the log whose matched laser messages carry the estimated
-//! poses (messages after `--scans` keep theirs).
+//! `--corrected-log FILE` (CARMEN input) a copy of the log whose matched laser messages carry
+//! the estimated poses (messages after `--scans` keep theirs).
 //!
 //! `--json` prints `{"scans", "time_s", "scans_per_s", "mode", "map_updates", "beams",
 //! "errors"}` (`errors` only with `--ground-truth`: `pairs`, `relative`, `aligned`).
+//!
+//! `--record OUT.mcap` writes a Foxglove recording (see `record` and `scan_match::record`):
+//! every scan at its estimated pose (`/tf`, `/scan`), the estimated `/trajectory`, and the
+//! finest map level as the Grids `/map` (occupancy probability) and `/reflectivity`.
 
+mod record;
+
+use std::collections::HashMap;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use raypath_geometry::Pose2;
+use raypath_geometry::{Pose2, Scan2};
 use raypath_io::carmen::{CarmenReader, CarmenWriter, Record};
+use raypath_io::sequence::{Origin, PlanarFrame, pair_by_ranges};
 use raypath_reflectivity::benchmark::{
-    LogScan, aligned_errors, consecutive_relations, pair_by_ranges, read_laser_log,
-    relative_errors, run_matcher,
+    aligned_errors, consecutive_relations, relative_errors, run_matcher,
 };
 use raypath_reflectivity::export::{tum_lines, write_occupancy_map, write_reflectivity_png};
 use raypath_reflectivity::{
@@ -30,11 +40,14 @@ use raypath_reflectivity::{
 use serde_json::json;
 
 use super::Failure;
+use super::record::{RecordArgs, Recording};
+use super::source_args::{SourceArgs, reference_track};
 
 /// Arguments of `raypath scan-match`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// A CARMEN log (plain, .gz or .bz2); FLASER scans, or ROBOTLASER1 with remissions.
+    /// A CARMEN log (plain, .gz or .bz2): FLASER scans, or ROBOTLASER1 with remissions; or a
+    /// rosbag2 bag (directory with metadata.yaml, or .mcap file) with LaserScan.
     pub log: PathBuf,
     /// Residual: occupancy (plain Hector), reflectivity (Khan) or combined.
     #[arg(long, default_value = "occupancy", value_name = "MODE")]
@@ -49,7 +62,8 @@ pub struct Args {
     /// Write the map as PREFIX.pgm + PREFIX.yaml (+ PREFIX-reflectivity.png).
     #[arg(long, value_name = "PREFIX")]
     pub map: Option<PathBuf>,
-    /// A corrected log of the same run: report the errors against its poses.
+    /// A corrected log of the same run, or a bag with reference poses: report the errors
+    /// against its poses.
     #[arg(long, value_name = "LOG")]
     pub ground_truth: Option<PathBuf>,
     /// Use the logged odometry as the initial guess of each match.
@@ -79,6 +93,12 @@ pub struct Args {
     /// Print one JSON document on standard output.
     #[arg(long)]
     pub json: bool,
+    /// How to read the log and the ground truth.
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// A Foxglove recording of the run.
+    #[command(flatten)]
+    pub record: RecordArgs,
 }
 
 fn failure(message: impl std::fmt::Display, json: bool) -> Failure {
@@ -150,35 +170,110 @@ fn read_lut(args: &Args, mode: ResidualMode) -> Result<Option<IntensityCorrectio
     Ok(Some(model))
 }
 
-/// Copies the log with the estimated poses in the laser messages that were matched (the
-/// first `poses.len()` messages of the matched kind); other lines are re-written as read.
+/// The scans of the log for the matcher (the logged `world_from_laser` is the odometry).
+fn read_scans(args: &Args) -> Result<Vec<PlanarFrame>, Failure> {
+    let frames = args
+        .source
+        .read_frames(&args.log)
+        .map_err(|e| Failure::input(e, args.json))?;
+    if frames.is_empty() {
+        return Err(Failure::input(
+            format!(
+                "{}: no laser scans ({})",
+                args.log.display(),
+                args.source.laser_lines()
+            ),
+            args.json,
+        ));
+    }
+    Ok(frames)
+}
+
+/// The lines of a CARMEN log's laser messages the scans came from; `None` for other sources.
+fn carmen_lines(scans: &[PlanarFrame]) -> Option<Vec<u64>> {
+    scans
+        .iter()
+        .map(|f| match f.origin {
+            Origin::Line(line) => Some(line),
+            Origin::LogTimeNs(_) => None,
+        })
+        .collect()
+}
+
+/// The TUM times of the scans: a CARMEN log's IPC timestamps (the first timestamp of each
+/// line; the sources keep the logger timestamp), else the frames' stamps.
+fn ipc_stamps(args: &Args, scans: &[PlanarFrame]) -> Result<Vec<f64>, Failure> {
+    let Some(lines) = carmen_lines(scans) else {
+        return Ok(scans.iter().map(|s| s.stamp_secs).collect());
+    };
+    let reader = CarmenReader::open(&args.log).map_err(|e| Failure::input(e, args.json))?;
+    let mut ipc: HashMap<u64, f64> = lines.iter().map(|&line| (line, f64::NAN)).collect();
+    for record in reader {
+        if let Record::Laser(m) = record.map_err(|e| Failure::input(e, args.json))?
+            && let Some(t) = ipc.get_mut(&m.line)
+        {
+            *t = m.ipc_timestamp_secs;
+        }
+    }
+    Ok(lines
+        .iter()
+        .map(|line| ipc.get(line).copied().unwrap_or(f64::NAN))
+        .collect())
+}
+
+fn not_carmen(args: &Args) -> Failure {
+    Failure::input(
+        format!(
+            "--corrected-log: {} is not a CARMEN log; a corrected copy is written for CARMEN \
+             logs only",
+            args.log.display()
+        ),
+        args.json,
+    )
+}
+
+/// Copies the log with the estimated poses in the laser messages that were matched (by line);
+/// other lines are re-written as read.
 fn write_corrected_log(
     args: &Args,
     path: &std::path::Path,
-    scans: &[LogScan],
+    scans: &[PlanarFrame],
     poses: &[Pose2],
 ) -> Result<(), Failure> {
-    let kind = scans.first().map(|s| s.kind);
+    let Some(lines) = carmen_lines(scans) else {
+        return Err(not_carmen(args));
+    };
+    let estimate: HashMap<u64, Pose2> = lines.into_iter().zip(poses.iter().copied()).collect();
     let reader = CarmenReader::open(&args.log).map_err(|e| Failure::input(e, args.json))?;
     let mut writer = CarmenWriter::create(path).map_err(|e| failure(e, args.json))?;
-    let mut k = 0;
     for record in reader {
         let mut record = record.map_err(|e| Failure::input(e, args.json))?;
         if let Record::Laser(m) = &mut record
-            && Some(m.kind) == kind
+            && let Some(pose) = estimate.get(&m.line)
         {
-            if let Some(pose) = poses.get(k) {
-                // The estimate is the laser's pose; keep the logged laser-on-robot offset.
-                let robot_from_laser = m.world_from_robot.inverse() * m.world_from_laser;
-                m.world_from_laser = *pose;
-                m.world_from_robot = *pose * robot_from_laser.inverse();
-            }
-            k += 1;
+            // The estimate is the laser's pose; keep the logged laser-on-robot offset.
+            let robot_from_laser = m.world_from_robot.inverse() * m.world_from_laser;
+            m.world_from_laser = *pose;
+            m.world_from_robot = *pose * robot_from_laser.inverse();
         }
         writer.record(&record).map_err(|e| failure(e, args.json))?;
     }
     writer.finish().map_err(|e| failure(e, args.json))?;
     Ok(())
+}
+
+/// The scans of the ground truth with their reference poses.
+fn read_reference(args: &Args, path: &std::path::Path) -> Result<Vec<(Scan2, Pose2)>, Failure> {
+    let frames = args
+        .source
+        .read_frames(path)
+        .map_err(|e| Failure::input(e, args.json))?;
+    let track = reference_track(&frames);
+    Ok(frames
+        .into_iter()
+        .zip(track)
+        .filter_map(|(f, pose)| Some((f.scan, pose?)))
+        .collect())
 }
 
 /// Runs the subcommand.
@@ -188,7 +283,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         return Err(Failure::input("--max-range: must be positive", args.json));
     }
     let lut = read_lut(args, config.mode)?;
-    let mut scans = read_laser_log(&args.log).map_err(|e| Failure::input(e, args.json))?;
+    let mut recording = Recording::open(&args.record, args.json)?;
+    let mut scans = read_scans(args)?;
+    if args.corrected_log.is_some() && carmen_lines(&scans).is_none() {
+        return Err(not_carmen(args));
+    }
     if let Some(n) = args.scans {
         scans.truncate(n.max(1));
     }
@@ -214,12 +313,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let time_s = start.elapsed().as_secs_f64();
     let poses: Vec<Pose2> = results.iter().map(|r| r.world_from_sensor).collect();
     if let Some(out) = &args.out {
-        let text = tum_lines(
-            scans
-                .iter()
-                .zip(&poses)
-                .map(|(s, p)| (s.ipc_timestamp_secs, *p)),
-        );
+        let stamps = ipc_stamps(args, &scans)?;
+        let text = tum_lines(stamps.into_iter().zip(poses.iter().copied()));
         std::fs::write(out, text)
             .map_err(|e| failure(format!("{}: {e}", out.display()), args.json))?;
     }
@@ -236,11 +331,17 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             }
         }
     }
+    if let Some(recording) = &mut recording {
+        record::record(recording, &scans, &poses, matcher.map().levels().first())?;
+    }
     let errors = match &args.ground_truth {
         None => None,
         Some(path) => {
-            let reference = read_laser_log(path).map_err(|e| Failure::input(e, args.json))?;
-            let pairs = pair_by_ranges(&scans, &reference);
+            let reference = read_reference(args, path)?;
+            let pairs = pair_by_ranges(
+                scans.iter().map(|s| &s.scan),
+                reference.iter().map(|(scan, _)| scan),
+            );
             if pairs.len() < 2 {
                 return Err(Failure::input(
                     format!(
@@ -253,7 +354,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             }
             let truth: Vec<Pose2> = pairs
                 .iter()
-                .filter_map(|&(_, j)| reference.get(j).map(|s| s.world_from_laser))
+                .filter_map(|&(_, j)| reference.get(j).map(|(_, pose)| *pose))
                 .collect();
             let est: Vec<Pose2> = pairs
                 .iter()
@@ -280,6 +381,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         if let (Some(e), Some(obj)) = (errors, doc.as_object_mut()) {
             obj.insert("errors".into(), e);
         }
+        super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
     } else {
         println!(
@@ -313,6 +415,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         if let Some(png) = reflectivity_png {
             println!("reflectivity map: {}", png.display());
         }
+        super::record::finish(recording, None)?;
     }
     Ok(())
 }

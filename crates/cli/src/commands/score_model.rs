@@ -1,10 +1,12 @@
-//! `raypath score-model`: score every sensor model on a corrected CARMEN log (Schaefer 2020,
-//! Tables 7.3, 8.2, 8.3).
+//! `raypath score-model`: score every sensor model on a corrected CARMEN log or a rosbag2 bag
+//! with reference poses (Schaefer 2020, Tables 7.3, 8.2, 8.3).
 //!
-//! The log's scans are split into a mapping set and a disjoint test set (default: even scans
-//! map, odd scans are scored), the maps are built with the log's (corrected) poses, and each
-//! model is scored by `D'` (Eq. 7.28: summed −ln p of the test rays at the true poses) and
-//! by the inverse KL (Eq. 7.29: 50 positions in a 2.5 m disc, averaged over test scans). See
+//! The scans are read through `raypath_io::sequence` (`--laser` picks the laser of a CARMEN
+//! log, front by default; a bag's LaserScan topic at its reference poses, else at its logged
+//! poses). The scans are split into a mapping set and a disjoint test set (default: even
+//! scans map, odd scans are scored), the maps are built with the reference poses, and each
+//! model is scored by `D'` (Eq. 7.28: summed −ln p of the test rays at the true poses) and by
+//! the inverse KL (Eq. 7.29: 50 positions in a 2.5 m disc, averaged over test scans). See
 //! [`raypath_sensor_models::scoring`] for the details.
 //!
 //! `--json` prints `{"rows": [{"model", "posterior", "neg_log_likelihood", "inverse_kl"}, …]}`
@@ -15,16 +17,18 @@
 use std::path::PathBuf;
 
 use raypath_geometry::{Pose2, Scan2};
-use raypath_io::carmen::{CarmenReader, Record};
 use raypath_sensor_models::scoring::{ScoreReport, ScoringConfig, Split, score_log};
 use serde_json::json;
 
 use super::Failure;
+use super::source_args::{SourceArgs, reference_track};
 
 /// Arguments of `raypath score-model`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// A CARMEN log with reference poses (a `*-corrected.log`, plain, .gz or .bz2).
+    /// A CARMEN log with reference poses (a `*-corrected.log`, plain, .gz or .bz2), or a
+    /// rosbag2 bag (directory with metadata.yaml, or .mcap file) with LaserScan and reference
+    /// poses.
     pub log: PathBuf,
     /// Print one JSON document on standard output.
     #[arg(long)]
@@ -50,6 +54,9 @@ pub struct Args {
     /// Maximum range in metres (default: the no-return threshold inferred from the log).
     #[arg(long, value_name = "M")]
     pub max_range: Option<f64>,
+    /// How to read the log.
+    #[command(flatten)]
+    pub source: SourceArgs,
 }
 
 /// Runs `raypath score-model`.
@@ -100,16 +107,18 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     Ok(())
 }
 
-/// The laser scans of the log with their reference poses.
+/// The laser scans of the log with their reference poses (scans without one are left out).
 fn read_scans(args: &Args) -> Result<Vec<(Pose2, Scan2)>, Failure> {
-    let reader = CarmenReader::open(&args.log).map_err(|e| Failure::input(e, args.json))?;
-    let mut scans = Vec::new();
-    for record in reader {
-        if let Record::Laser(laser) = record.map_err(|e| Failure::input(e, args.json))? {
-            scans.push((laser.world_from_laser, laser.scan));
-        }
-    }
-    Ok(scans)
+    let frames = args
+        .source
+        .read_frames(&args.log)
+        .map_err(|e| Failure::input(e, args.json))?;
+    let track = reference_track(&frames);
+    Ok(frames
+        .into_iter()
+        .zip(track)
+        .filter_map(|(f, pose)| Some((pose?, f.scan)))
+        .collect())
 }
 
 /// The JSON document: `rows` with exactly the four contract keys, the rest top-level.

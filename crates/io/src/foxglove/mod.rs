@@ -53,13 +53,18 @@
 //! | --- | --- | --- |
 //! | `/map` | Grid | the 2-D map (one message at the end, or one per update) |
 //! | `/scan` | LaserScan | the scans, in `base_link` (or the laser's frame) at their stamps |
-//! | `/points` | PointCloud | 3-D scans or maps, planes coloured by label |
+//! | `/points` | PointCloud | 3-D scans, planes coloured by label |
 //! | `/trajectory` | PosesInFrame | the estimated trajectory in `map` |
 //! | `/tf` | FrameTransform | `map → base_link` per scan |
 //! | `/poles` | SceneUpdate | poles as cylinders |
 //! | `/polylines` | SceneUpdate | polylines as line strips |
 //! | `/planes` | SceneUpdate | planes as triangle lists and outlines |
 //! | `/octree` | SceneUpdate | occupied octree leaves as cubes |
+//! | `/map_points` | PointCloud | occupied cells of 3-D maps and octrees |
+//! | `/ground_truth` | PosesInFrame | the reference trajectory |
+//! | `/loops` | SceneUpdate | loop closures as a line list |
+//! | `/reflectivity` | Grid | the reflectivity map of scan matching |
+//! | `/baseline` | Grid | the grid baseline beside a DCT map |
 //!
 //! Frames follow REP-103 and REP-105: `map` (the world), `base_link` (the robot); a
 //! transform's pose is `parent_from_child` (where the child frame is in the parent frame).
@@ -130,6 +135,16 @@ pub mod topic {
     pub const PLANES: &str = "/planes";
     /// Occupied octree leaves as cubes (`foxglove.SceneUpdate`).
     pub const OCTREE: &str = "/octree";
+    /// Occupied cells of 3-D maps and octrees as points (`foxglove.PointCloud`).
+    pub const MAP_POINTS: &str = "/map_points";
+    /// The reference trajectory (`foxglove.PosesInFrame`).
+    pub const GROUND_TRUTH: &str = "/ground_truth";
+    /// Detected loop closures as a line list between matched poses (`foxglove.SceneUpdate`).
+    pub const LOOPS: &str = "/loops";
+    /// The reflectivity map of scan matching (`foxglove.Grid`).
+    pub const REFLECTIVITY: &str = "/reflectivity";
+    /// The grid baseline beside a DCT map (`foxglove.Grid`).
+    pub const BASELINE: &str = "/baseline";
 }
 
 /// The frame names the raypath commands record in (REP-105).

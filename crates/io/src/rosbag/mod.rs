@@ -15,7 +15,7 @@
 //!
 //! | type | read as | what is ignored |
 //! |---|---|---|
-//! | `sensor_msgs/msg/LaserScan` | [`PlanarFrame::scan`](crate::sequence::PlanarFrame) (ranges and intensities widened to `f64`) | `angle_max` (implied by the count), `time_increment`, `scan_time` |
+//! | `sensor_msgs/msg/LaserScan` | [`PlanarFrame::scan`](crate::sequence::PlanarFrame) (ranges, intensities and angles widened to `f64` by [`widen_decimal`] / [`widen_angle`]) | `angle_max` (implied by the count), `time_increment`, `scan_time` |
 //! | `sensor_msgs/msg/PointCloud2` | sweeps of a [`SweepSequence`] (`x`, `y`, `z` as float32/float64; `intensity`, else `reflectivity`, of any numeric type; either byte order; any `point_step`/`row_step`) | every other field (`ring`, `time`, `rgb`, …), `is_dense` |
 //! | `nav_msgs/msg/Odometry` | the robot's pose (`header.frame_id` → `child_frame_id`) | covariances, twist |
 //! | `tf2_msgs/msg/TFMessage` | the tf tree (topics ending in `tf_static` are static) | — |
@@ -64,9 +64,12 @@
 //! after `====…` / `MSG: pkg/Type` lines, as rosbag2 stores them) and CDR messages, in zstd
 //! (default), LZ4 or uncompressed chunks, as one `.mcap` file or a bag directory with
 //! `metadata.yaml`. [`write_planar`] and [`write_sweeps`] write whole sequences. Scans go
-//! through `float32`: a CARMEN log written as a bag and read back gives the same scans up to
-//! `float32` rounding of ranges and angles (relative 6e-8), stamps to the nanosecond, and the
-//! same poses (to 1e-9).
+//! through `float32`; the reader widens a `float32` to the short decimal (at most four
+//! fractional digits; for angles, degrees) that rounds to it when there is one
+//! ([`widen_decimal`], [`widen_angle`]), so a CARMEN log written as a bag and read back gives
+//! the same ranges and beam angles bit for bit, stamps to the nanosecond, and the same poses
+//! to 1e-12 (headings pass through quaternions): `raypath map` of the bag writes the same
+//! PGM as of the log, with cell statistics equal up to the last bits.
 //!
 //! ```no_run
 //! use raypath_io::rosbag;
@@ -103,7 +106,8 @@ pub use cloud::{decode_cloud, encode_cloud};
 pub use info::{BagInfo, TopicInfo, info};
 pub use msgs::{
     Header, Odometry, Stamp, Transform, decode_odometry, decode_pose_stamped, decode_scan,
-    decode_tf, encode_odometry, encode_pose_stamped, encode_scan, encode_tf,
+    decode_tf, encode_odometry, encode_pose_stamped, encode_scan, encode_tf, widen_angle,
+    widen_decimal,
 };
 pub use planar::{BagScans, open_planar};
 pub use sweeps::open_sweeps;

@@ -123,7 +123,7 @@ pub fn write_pose(w: &mut CdrWriter, pose: &Pose3) {
 /// `1.2300000190734863`), else the exact widening. Either way the result rounds to `v`.
 pub fn widen_decimal(v: f32) -> f64 {
     let exact = f64::from(v);
-    if !(exact.abs() < 1e9) {
+    if exact.is_nan() || exact.abs() >= 1e9 {
         return exact;
     }
     let decimal = (exact * 1e4).round() / 1e4;
@@ -339,13 +339,23 @@ mod tests {
         // Not a short decimal: the exact widening, which rounds back.
         let odd = 1.234_567_9_f32;
         assert_eq!(widen_decimal(odd), f64::from(odd));
-        for v in [0.1_f32, 3.3, 12.345, 1e-7, 5e3, f32::MAX, f32::MIN_POSITIVE, -2.5] {
+        for v in [
+            0.1_f32,
+            3.3,
+            12.345,
+            1e-7,
+            5e3,
+            f32::MAX,
+            f32::MIN_POSITIVE,
+            -2.5,
+        ] {
             assert_eq!(widen_decimal(v) as f32, v, "{v}");
             assert_eq!(widen_angle(v) as f32, v, "{v}");
         }
         // The CARMEN fans (FanConvention::Auto over π) come back bit for bit.
         for n in [180_usize, 181, 360, 361] {
-            let (first, increment) = crate::carmen::FanConvention::Auto.layout(n, std::f64::consts::PI, None);
+            let (first, increment) =
+                crate::carmen::FanConvention::Auto.layout(n, std::f64::consts::PI, None);
             assert_eq!(widen_angle(first as f32), first, "{n}");
             assert_eq!(widen_angle(increment as f32), increment, "{n}");
         }

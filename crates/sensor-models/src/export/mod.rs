@@ -6,5 +6,6 @@ mod ros_map;
 
 pub use binary::{MapFile, MapKind, StoredStats};
 pub use ros_map::{
-    MapPicture, RosMapOptions, UNKNOWN_PIXEL, map_image, picture_values, write_png, write_ros_map,
+    MapPicture, RosMapOptions, UNKNOWN_PIXEL, map_image, picture_value, picture_values, write_png,
+    write_ros_map,
 };

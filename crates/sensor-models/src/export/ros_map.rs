@@ -34,24 +34,29 @@ pub enum MapPicture {
 /// The per-cell probabilities a picture shows (`None`: unknown cell).
 pub fn picture_values(stats: &DenseStats2, picture: MapPicture) -> Vec<Option<f64>> {
     let c = stats.grid().cell_size();
-    let log_odds = LogOddsConfig::default();
     stats
         .cells()
         .iter()
-        .map(|cell: &CellStats| match picture {
-            MapPicture::Reflection => {
-                let n = cell.h() + cell.m();
-                (n > 0.0).then(|| cell.h() / n)
-            }
-            MapPicture::DecayRate => {
-                let r = cell.path_length_m();
-                (r > 0.0).then(|| -(-(cell.h() / r) * c).exp_m1())
-            }
-            MapPicture::Occupancy => {
-                (cell.hits() > 0 || cell.misses() > 0).then(|| log_odds.occupancy(cell))
-            }
-        })
+        .map(|cell| picture_value(cell, picture, c))
         .collect()
+}
+
+/// The probability a picture shows for one cell of edge `cell_m` in 2-D or 3-D (`None`:
+/// unknown cell).
+pub fn picture_value(cell: &CellStats, picture: MapPicture, cell_m: f64) -> Option<f64> {
+    match picture {
+        MapPicture::Reflection => {
+            let n = cell.h() + cell.m();
+            (n > 0.0).then(|| cell.h() / n)
+        }
+        MapPicture::DecayRate => {
+            let r = cell.path_length_m();
+            (r > 0.0).then(|| -(-(cell.h() / r) * cell_m).exp_m1())
+        }
+        MapPicture::Occupancy => {
+            (cell.hits() > 0 || cell.misses() > 0).then(|| LogOddsConfig::default().occupancy(cell))
+        }
+    }
 }
 
 /// The `map_server` YAML fields besides the image name, resolution and origin.

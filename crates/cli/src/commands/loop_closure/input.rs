@@ -1,21 +1,25 @@
-//! The frames of `raypath loop-closure`: the front-laser scans of a CARMEN log, the velodyne
-//! scans of a KITTI sequence, or the PNG/JPEG images of a folder (sorted by file name).
+//! The frames of `raypath loop-closure`, read through `raypath_io::sequence`: planar scans (a
+//! CARMEN log's laser `--laser`, or a bag's LaserScan topic), 3-D sweeps (a KITTI sequence,
+//! an NCLT session, or a bag's PointCloud2 topic), or the PNG/JPEG images of a folder (sorted
+//! by file name).
 
 use std::path::{Path, PathBuf};
 
-use raypath_geometry::Scan2;
-use raypath_io::carmen::CarmenReader;
-use raypath_io::kitti::KittiSequence;
+use raypath_geometry::{Pose3, Scan2};
+use raypath_io::sequence::{PlanarFrame, PlanarSource, SweepFormat, SweepSequence};
 use raypath_place_recognition::{OwnedFrame, PlaceError};
 
 use super::super::Failure;
+use super::super::source_args::{
+    BagSource, Laser, SourceArgs, is_bag, reference_track, sweep_poses,
+};
 
 /// Where the frames come from.
 pub enum Source {
-    /// Front-laser scans of a CARMEN log, held in memory.
-    Carmen(Vec<Scan2>),
-    /// A KITTI sequence; scans are read one at a time.
-    Kitti(KittiSequence),
+    /// Planar scans, held in memory.
+    Planar(Vec<Scan2>),
+    /// 3-D sweeps; read one at a time.
+    Sweeps(Box<SweepSequence>),
     /// Image files in name order; decoded one at a time.
     Images(Vec<PathBuf>),
 }
@@ -26,11 +30,18 @@ pub struct Input {
     pub path: PathBuf,
     /// The frames.
     pub source: Source,
-    /// Frame times in seconds, when known: CARMEN logger timestamps, KITTI `times.txt`, or
-    /// image names of the form `<seconds>.<fraction>.<ext>` (TUM RGB-D).
+    /// What the frames are, in words.
+    pub kind: &'static str,
+    /// Frame times in seconds, when known: CARMEN logger timestamps, bag header stamps, KITTI
+    /// `times.txt`, NCLT scan times, or image names of the form `<seconds>.<fraction>.<ext>`
+    /// (TUM RGB-D).
     pub times: Option<Vec<f64>>,
     /// The number reported for each frame: its index, or its frame number for KITTI.
     pub labels: Vec<usize>,
+    /// The input's own pose of each frame, when it has poses: planar scans their reference
+    /// poses (else the logged ones, see `reference_track`), sweeps their reference poses (else
+    /// the odometry); images none.
+    pub poses: Option<Vec<Option<Pose3>>>,
     /// Number of frames before `--max-frames`.
     pub total: usize,
 }
@@ -43,44 +54,41 @@ impl Input {
 
     /// What the frames are, in words.
     pub fn kind(&self) -> &'static str {
-        match self.source {
-            Source::Carmen(_) => "CARMEN front-laser scans",
-            Source::Kitti(_) => "KITTI velodyne scans",
-            Source::Images(_) => "images",
-        }
+        self.kind
     }
 
     /// True for planar scans.
     pub fn is_planar(&self) -> bool {
-        matches!(self.source, Source::Carmen(_))
+        matches!(self.source, Source::Planar(_))
+    }
+
+    /// True when ground-truth poses without times pair with the frames by frame number.
+    pub fn numbered_by_frame(&self) -> bool {
+        matches!(&self.source, Source::Sweeps(s) if s.format == SweepFormat::Kitti)
     }
 
     /// Angular span of the first scan (planar input), radians.
     pub fn scan_fov_rad(&self) -> Option<f64> {
         match &self.source {
-            Source::Carmen(scans) => scans
+            Source::Planar(scans) => scans
                 .first()
                 .map(|s| (s.angle_max_rad() - s.angle_min_rad).abs()),
             _ => None,
         }
     }
 
-    /// Frame `i`, read from disk for KITTI and images. Errors name the file.
+    /// Frame `i`, read from disk for sweeps and images. Errors name the file.
     pub fn frame(&self, i: usize) -> Result<OwnedFrame, PlaceError> {
         match &self.source {
-            Source::Carmen(scans) => scans
+            Source::Planar(scans) => scans
                 .get(i)
                 .cloned()
                 .map(OwnedFrame::Planar)
                 .ok_or_else(|| PlaceError::BadInput(format!("no scan {i}"))),
-            Source::Kitti(seq) => {
-                let frame = self.labels.get(i).copied().unwrap_or(usize::MAX) as u64;
-                match seq.scan(frame) {
-                    Some(Ok(cloud)) => Ok(OwnedFrame::Cloud(cloud)),
-                    Some(Err(e)) => Err(PlaceError::BadInput(e.to_string())),
-                    None => Err(PlaceError::BadInput(format!("no velodyne scan {frame}"))),
-                }
-            }
+            Source::Sweeps(sequence) => sequence
+                .sweep(i)
+                .map(OwnedFrame::Cloud)
+                .map_err(|e| PlaceError::BadInput(e.to_string())),
             Source::Images(files) => {
                 let path = files
                     .get(i)
@@ -93,22 +101,60 @@ impl Input {
     }
 }
 
-/// Reads the input: a directory is a KITTI sequence (with `velodyne/`) or an image folder, a
-/// file a CARMEN log. `max_frames` keeps the first frames only.
-pub fn read_input(path: &Path, max_frames: Option<usize>, json: bool) -> Result<Input, Failure> {
-    let mut input = if path.is_dir() {
-        match KittiSequence::open(path) {
-            Ok(seq) if !seq.scan_files.is_empty() => read_kitti(path, seq, json)?,
-            _ => read_images(path, json)?,
+/// Reads the input: a bag (its LaserScan or PointCloud2 topic), a directory with velodyne
+/// scans (a KITTI sequence or an NCLT session) or else an image folder, a file a CARMEN log.
+/// `max_frames` keeps the first frames only.
+pub fn read_input(
+    path: &Path,
+    source: &SourceArgs,
+    max_frames: Option<usize>,
+    json: bool,
+) -> Result<Input, Failure> {
+    let mut input = if is_bag(path) {
+        match source.open_bag(path).map_err(|e| Failure::input(e, json))? {
+            BagSource::Planar(frames) => read_planar(path, frames, "LaserScan messages", json)?,
+            BagSource::Sweeps(sequence) => read_sweeps(path, *sequence),
+        }
+    } else if path.is_dir() {
+        let has = |p: &str| path.join(p).exists();
+        if has("velodyne") || has("velodyne_sync") || has("sequences") {
+            let sequence = source
+                .open_sweeps(path)
+                .map_err(|e| Failure::input(e, json))?;
+            read_sweeps(path, sequence)
+        } else {
+            read_images(path, json)?
         }
     } else {
-        read_carmen(path, json)?
+        let frames = source
+            .open_planar(path)
+            .map_err(|e| Failure::input(e, json))?;
+        let kind = match source.laser {
+            Laser::Front => "CARMEN front-laser scans",
+            Laser::Rear => "CARMEN rear-laser scans",
+            Laser::Any => "CARMEN laser scans",
+        };
+        let input = read_planar(path, frames, kind, json)?;
+        if input.labels.is_empty() {
+            return Err(Failure::input(
+                format!(
+                    "{}: no laser scans ({})",
+                    path.display(),
+                    source.laser_lines()
+                ),
+                json,
+            ));
+        }
+        input
     };
     input.total = input.labels.len();
     if let Some(n) = max_frames {
         input.labels.truncate(n);
         if let Some(t) = &mut input.times {
             t.truncate(n);
+        }
+        if let Some(p) = &mut input.poses {
+            p.truncate(n);
         }
     }
     if input.labels.is_empty() {
@@ -120,46 +166,68 @@ pub fn read_input(path: &Path, max_frames: Option<usize>, json: bool) -> Result<
     Ok(input)
 }
 
-fn read_carmen(path: &Path, json: bool) -> Result<Input, Failure> {
-    let reader = CarmenReader::open(path).map_err(|e| Failure::input(e, json))?;
-    let mut scans = Vec::new();
-    let mut times = Vec::new();
-    for m in reader.front_lasers() {
-        let m = m.map_err(|e| Failure::input(e, json))?;
-        times.push(m.logger_timestamp_secs);
-        scans.push(m.scan);
-    }
-    if scans.is_empty() {
-        return Err(Failure::input(
-            format!(
-                "{}: no front-laser scans (FLASER or ROBOTLASER1)",
-                path.display()
-            ),
-            json,
-        ));
-    }
+fn read_planar(
+    path: &Path,
+    source: Box<dyn PlanarSource>,
+    kind: &'static str,
+    json: bool,
+) -> Result<Input, Failure> {
+    let frames: Vec<PlanarFrame> = source
+        .collect::<raypath_io::Result<_>>()
+        .map_err(|e| Failure::input(e, json))?;
+    let times: Vec<f64> = frames.iter().map(|f| f.stamp_secs).collect();
     let times = times.iter().all(|t| t.is_finite()).then_some(times);
+    let poses = reference_track(&frames)
+        .into_iter()
+        .map(|p| p.map(|p| p.to_pose3()))
+        .collect();
+    let scans: Vec<Scan2> = frames.into_iter().map(|f| f.scan).collect();
     Ok(Input {
         path: path.to_path_buf(),
         labels: (0..scans.len()).collect(),
-        source: Source::Carmen(scans),
+        poses: Some(poses),
+        source: Source::Planar(scans),
+        kind,
         times,
         total: 0,
     })
 }
 
-fn read_kitti(path: &Path, seq: KittiSequence, json: bool) -> Result<Input, Failure> {
-    let labels: Vec<usize> = seq.scan_files.iter().map(|f| f.frame as usize).collect();
-    let all_times = seq.times().map_err(|e| Failure::input(e, json))?;
-    // Times are indexed by frame number.
-    let times: Option<Vec<f64>> = labels.iter().map(|&f| all_times.get(f).copied()).collect();
-    Ok(Input {
+fn read_sweeps(path: &Path, sequence: SweepSequence) -> Input {
+    let kind = match sequence.format {
+        SweepFormat::Kitti => "KITTI velodyne scans",
+        SweepFormat::Nclt => "NCLT velodyne scans",
+        SweepFormat::Bag => "PointCloud2 sweeps",
+    };
+    let labels = frame_numbers(&sequence);
+    let poses = sweep_poses(&sequence).map(|(poses, _)| poses.iter().copied().map(Some).collect());
+    Input {
         path: path.to_path_buf(),
-        source: Source::Kitti(seq),
-        times,
+        times: Some(sequence.stamps_secs.clone()),
         labels,
+        poses,
+        kind,
+        source: Source::Sweeps(Box::new(sequence)),
         total: 0,
-    })
+    }
+}
+
+/// The number of each sweep: its KITTI frame number (from its file name), else its index.
+fn frame_numbers(sequence: &SweepSequence) -> Vec<usize> {
+    let indices = || (0..sequence.len()).collect();
+    if sequence.format != SweepFormat::Kitti {
+        return indices();
+    }
+    // TODO(raypath-io): `SweepSequence` does not expose KITTI frame numbers yet; the scan
+    // list (a directory listing, no scan is read) gives them.
+    match raypath_io::kitti::KittiSequence::open(&sequence.name) {
+        Ok(listing) if listing.scan_files.len() == sequence.len() => listing
+            .scan_files
+            .iter()
+            .map(|f| usize::try_from(f.frame).unwrap_or(usize::MAX))
+            .collect(),
+        _ => indices(),
+    }
 }
 
 fn read_images(path: &Path, json: bool) -> Result<Input, Failure> {
@@ -180,7 +248,8 @@ fn read_images(path: &Path, json: bool) -> Result<Input, Failure> {
     if files.is_empty() {
         return Err(Failure::input(
             format!(
-                "{}: neither a KITTI sequence (velodyne/*.bin) nor a folder of PNG/JPEG images",
+                "{}: neither a KITTI sequence (velodyne/*.bin), an NCLT session \
+                 (velodyne_sync/*.bin), a rosbag2 bag nor a folder of PNG/JPEG images",
                 path.display()
             ),
             json,
@@ -192,6 +261,8 @@ fn read_images(path: &Path, json: bool) -> Result<Input, Failure> {
         path: path.to_path_buf(),
         labels: (0..files.len()).collect(),
         source: Source::Images(files),
+        poses: None,
+        kind: "images",
         times,
         total: 0,
     })

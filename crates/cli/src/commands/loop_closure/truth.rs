@@ -1,8 +1,11 @@
-//! Ground truth of `raypath loop-closure`: poses from a CARMEN (corrected) log, a KITTI pose
-//! file (12 numbers a line) or a TUM file (`t x y z qx qy qz qw`), paired with the frames.
+//! Ground truth of `raypath loop-closure`: poses from a KITTI pose file (12 numbers a line), a
+//! TUM file (`t x y z qx qy qz qw`), or a source of `raypath_io::sequence` — a CARMEN
+//! (corrected) log or a bag's LaserScan topic (its reference poses, else its logged poses, see
+//! `reference_track`), or a bag's PointCloud2 topic (its reference poses) — paired with the
+//! frames.
 //!
 //! Pairing: by index (by frame number for a KITTI sequence) when the file has no times (KITTI
-//! poses) or as many poses as the input has frames (CARMEN: front-laser scans); else by time —
+//! poses) or as many poses as the input has frames (CARMEN: the laser scans); else by time —
 //! the pose at a frame's time, interpolated between the two ground-truth poses around it when
 //! they are at most [`MAX_GAP_SECS`] apart. Frames that get no pose are left out of the
 //! evaluation.
@@ -10,10 +13,11 @@
 use std::path::Path;
 
 use raypath_geometry::{Pose2, Pose3};
-use raypath_io::carmen::CarmenReader;
+use raypath_io::sequence::PlanarFrame;
 use raypath_place_recognition::{Exclusion, GroundTruth};
 
 use super::super::Failure;
+use super::super::source_args::{BagSource, SourceArgs, is_bag, reference_track};
 use super::input::Input;
 
 /// Largest gap between two ground-truth poses that a frame's pose is interpolated over,
@@ -43,14 +47,16 @@ pub struct TruthParams {
     pub exclusion: Exclusion,
 }
 
-/// Reads the ground-truth file and builds the revisits of the input's frames.
+/// Reads the ground-truth file and builds the revisits of the input's frames; also returns
+/// the ground-truth pose of each frame (`None` where none pairs with it).
 pub fn ground_truth(
     path: &Path,
+    source: &SourceArgs,
     input: &Input,
     params: &TruthParams,
     json: bool,
-) -> Result<GroundTruth, Failure> {
-    let truth = read_truth(path, json)?;
+) -> Result<(GroundTruth, Vec<Option<Pose3>>), Failure> {
+    let truth = read_truth(path, source, json)?;
     let paired = pair(&truth, input);
     if paired.iter().all(Option::is_none) {
         return Err(Failure::input(
@@ -87,12 +93,33 @@ pub fn ground_truth(
             .collect();
         GroundTruth::from_positions(&positions, times, params.radius_m, params.exclusion)
     };
-    built.map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))
+    let built = built.map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))?;
+    Ok((built, paired))
 }
 
-/// Reads a TUM or KITTI pose file, or else a CARMEN log (its front-laser poses and logger
+/// Reads a TUM or KITTI pose file, or else a bag or a CARMEN log (their reference poses and
 /// times).
-fn read_truth(path: &Path, json: bool) -> Result<TruthPoses, Failure> {
+fn read_truth(path: &Path, source: &SourceArgs, json: bool) -> Result<TruthPoses, Failure> {
+    if is_bag(path) {
+        return match source.open_bag(path).map_err(|e| Failure::input(e, json))? {
+            BagSource::Planar(frames) => {
+                let frames = frames
+                    .collect::<raypath_io::Result<Vec<_>>>()
+                    .map_err(|e| Failure::input(e, json))?;
+                planar_truth(path, &frames, json)
+            }
+            BagSource::Sweeps(sequence) => {
+                let poses = sequence
+                    .require_reference()
+                    .map_err(|e| Failure::input(e, json))?
+                    .to_vec();
+                Ok(TruthPoses {
+                    poses,
+                    times: Some(sequence.stamps_secs.clone()),
+                })
+            }
+        };
+    }
     // Text pose files are plain UTF-8; CARMEN logs may be compressed.
     if let Ok(text) = std::fs::read_to_string(path) {
         let first = text
@@ -125,18 +152,27 @@ fn read_truth(path: &Path, json: bool) -> Result<TruthPoses, Failure> {
             _ => {}
         }
     }
-    let reader = CarmenReader::open(path).map_err(|e| Failure::input(e, json))?;
+    let frames = source
+        .read_frames(path)
+        .map_err(|e| Failure::input(e, json))?;
+    planar_truth(path, &frames, json)
+}
+
+/// The reference poses of planar frames and their times (frames without one are left out).
+fn planar_truth(path: &Path, frames: &[PlanarFrame], json: bool) -> Result<TruthPoses, Failure> {
     let mut poses = Vec::new();
     let mut times = Vec::new();
-    for m in reader.front_lasers() {
-        let m = m.map_err(|e| Failure::input(e, json))?;
-        poses.push(m.world_from_laser.to_pose3());
-        times.push(m.logger_timestamp_secs);
+    for (frame, pose) in frames.iter().zip(reference_track(frames)) {
+        if let Some(pose) = pose {
+            poses.push(pose.to_pose3());
+            times.push(frame.stamp_secs);
+        }
     }
     if poses.is_empty() {
         return Err(Failure::input(
             format!(
-                "{}: no poses (neither a CARMEN log with laser scans, KITTI poses nor a TUM file)",
+                "{}: no poses (neither a CARMEN log with laser scans, a bag, KITTI poses nor a \
+                 TUM file)",
                 path.display()
             ),
             json,
@@ -160,7 +196,7 @@ fn read_tum(path: &Path, json: bool) -> Result<TruthPoses, Failure> {
 /// The ground-truth pose of each frame (see the module documentation).
 fn pair(truth: &TruthPoses, input: &Input) -> Vec<Option<Pose3>> {
     if truth.times.is_none() || truth.poses.len() == input.total {
-        let by_number = matches!(input.source, super::input::Source::Kitti(_));
+        let by_number = input.numbered_by_frame();
         return (0..input.len())
             .map(|i| {
                 let k = if by_number { input.labels[i] } else { i };

@@ -1,14 +1,18 @@
-//! Reading the input of `raypath map`: a CARMEN log (2-D) or a KITTI / NCLT directory (3-D),
-//! into posed scans and the box the map must cover.
+//! Reading the input of `raypath map` through the sources of `raypath_io::sequence`: planar
+//! scans (a CARMEN log, a bag's LaserScan topic) → 2-D, or 3-D sweeps (a KITTI sequence, an
+//! NCLT session, a bag's PointCloud2 topic) → 3-D, into posed scans and the box the map must
+//! cover.
 
 use std::path::Path;
 
 use nalgebra::{Point2, Point3};
 use raypath_geometry::{Aabb2, Aabb3, PointCloud, Pose2, Pose3, Ray3, Scan2};
-use raypath_io::carmen::{CarmenReader, Record};
-use raypath_io::kitti::{self, KittiSequence};
-use raypath_io::nclt::{self, NcltSession};
+use raypath_io::sequence::{PlanarFrame, PlanarSource, SweepSequence};
 use raypath_sensor_models::MappingConfig;
+
+use crate::commands::source_args::{
+    BagSource, SourceArgs, is_bag, place, reference_track, sweep_poses,
+};
 
 /// One 3-D sweep: the points (sensor frame) with the sensor's pose.
 pub struct Sweep3 {
@@ -42,6 +46,8 @@ pub enum Input {
     Planar {
         /// Scans and poses.
         scans: Vec<(Pose2, Scan2)>,
+        /// Per scan: its stamp (seconds) and the laser's mounting `robot_from_laser`.
+        frames: Vec<(f64, Pose2)>,
         /// Sensor positions and returns within r_max, padded.
         bounds: Aabb2,
     },
@@ -49,149 +55,120 @@ pub enum Input {
     Spatial {
         /// Sweeps with poses.
         sweeps: Vec<Sweep3>,
+        /// Per sweep: its stamp, seconds.
+        stamps: Vec<f64>,
         /// Sensor positions and returns within r_max, padded.
         bounds: Aabb3,
     },
 }
 
 impl Input {
-    /// Reads `path`: a directory is a KITTI sequence or an NCLT session, a file a CARMEN
-    /// log. Errors name the file and the place.
-    pub fn read(path: &Path, step: usize, config: &MappingConfig) -> Result<Self, String> {
+    /// Reads `path`: a bag (its LaserScan or PointCloud2 topic), a directory (a KITTI
+    /// sequence or an NCLT session) or a CARMEN log. Errors name the file and the place.
+    pub fn read(
+        path: &Path,
+        source: &SourceArgs,
+        step: usize,
+        config: &MappingConfig,
+    ) -> Result<Self, String> {
+        if is_bag(path) {
+            return match source.open_bag(path)? {
+                BagSource::Planar(frames) => read_planar(frames, "laser scans", config),
+                BagSource::Sweeps(sequence) => read_sweeps(&sequence, step, config),
+            };
+        }
         let metadata =
             std::fs::metadata(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
-        let input = if metadata.is_dir() {
-            let kitti_like = path.join("velodyne").is_dir() || path.join("poses.txt").is_file();
-            if kitti_like {
-                read_kitti(path, step, config)?
-            } else {
-                read_nclt(path, step, config)?
-            }
+        if metadata.is_dir() {
+            let sequence = source.open_sweeps(path).map_err(|e| e.to_string())?;
+            read_sweeps(&sequence, step, config)
         } else {
-            read_carmen(path, config)?
-        };
-        Ok(input)
+            let frames = source.open_planar(path).map_err(|e| e.to_string())?;
+            let what = format!("laser messages ({}) in the log", source.laser_lines());
+            read_planar(frames, &what, config)
+        }
     }
 }
 
-fn read_carmen(path: &Path, config: &MappingConfig) -> Result<Input, String> {
-    let reader = CarmenReader::open(path).map_err(|e| e.to_string())?;
+/// The scans with their reference poses (see `reference_track`); `what` names the scans
+/// for the message when there are none.
+fn read_planar(
+    source: Box<dyn PlanarSource>,
+    what: &str,
+    config: &MappingConfig,
+) -> Result<Input, String> {
+    let name = source.name().to_path_buf();
+    let frames: Vec<PlanarFrame> = source
+        .collect::<raypath_io::Result<_>>()
+        .map_err(|e| e.to_string())?;
+    if frames.is_empty() {
+        return Err(format!("{}: no {what}", name.display()));
+    }
     let max_range = config.range.max_range_m;
-    let mut scans = Vec::new();
+    let mut scans = Vec::with_capacity(frames.len());
+    let mut stamps = Vec::with_capacity(frames.len());
     let mut bounds = Aabb2::empty();
-    for record in reader {
-        let Record::Laser(laser) = record.map_err(|e| e.to_string())? else {
-            continue;
-        };
-        let pose = laser.world_from_laser;
+    let track = reference_track(&frames);
+    for (frame, pose) in frames.into_iter().zip(track) {
+        let Some(pose) = pose else { continue };
         if !pose.is_finite() {
             return Err(format!(
-                "{}:{}: the laser pose is not finite",
-                path.display(),
-                laser.line
+                "{}: the laser pose is not finite",
+                place(&name, frame.origin)
             ));
         }
         bounds.extend(&Point2::new(pose.x(), pose.y()));
-        for ray in laser.scan.rays(pose) {
+        for ray in frame.scan.rays(pose) {
             if let Some(t) = ray.range.hit().filter(|&t| t < max_range) {
                 bounds.extend(&ray.at(t));
             }
         }
-        scans.push((pose, laser.scan));
+        stamps.push((frame.stamp_secs, frame.robot_from_laser()));
+        scans.push((pose, frame.scan));
     }
-    if scans.is_empty() {
-        return Err(format!(
-            "{}: no laser messages (FLASER, RLASER or ROBOTLASER1) in the log",
-            path.display()
-        ));
-    }
-    Ok(Input::Planar { scans, bounds })
+    Ok(Input::Planar {
+        scans,
+        frames: stamps,
+        bounds,
+    })
 }
 
-fn read_kitti(dir: &Path, step: usize, config: &MappingConfig) -> Result<Input, String> {
-    let sequence = KittiSequence::open(dir).map_err(|e| e.to_string())?;
-    let cam_poses = sequence.poses().map_err(|e| e.to_string())?;
-    if cam_poses.is_empty() {
+/// The sweeps at their reference poses (the odometry, with a warning, when the sequence has
+/// no reference poses).
+fn read_sweeps(
+    sequence: &SweepSequence,
+    step: usize,
+    config: &MappingConfig,
+) -> Result<Input, String> {
+    let name = sequence.name.display();
+    if sequence.is_empty() {
         return Err(format!(
-            "{}: the KITTI sequence has no poses.txt (or ../../poses/NN.txt): map building needs \
-             ground-truth poses",
-            dir.display()
+            "{name}: no velodyne scans to map (velodyne/*.bin or velodyne_sync/*.bin)"
         ));
     }
-    let calib = sequence.calib().map_err(|e| e.to_string())?;
-    let poses = match calib.and_then(|c| c.cam0_from_velo()) {
-        Some(cam0_from_velo) => kitti::velodyne_poses_from_cam0(&cam_poses, &cam0_from_velo),
-        None => cam_poses,
+    let Some((poses, odometry)) = sweep_poses(sequence) else {
+        return Err(format!(
+            "{name}: no sensor poses (KITTI poses.txt, NCLT ground truth or odometry, a bag's \
+             reference or odometry poses): map building needs them"
+        ));
     };
-    let mut sweeps = Vec::new();
-    for scan in sequence.scans() {
-        let scan = scan.map_err(|e| e.to_string())?;
-        let pose = usize::try_from(scan.frame)
-            .ok()
-            .and_then(|i| poses.get(i))
-            .copied()
-            .ok_or_else(|| {
-                format!(
-                    "{}: scan {} has no pose ({} poses)",
-                    dir.display(),
-                    scan.frame,
-                    poses.len()
-                )
-            })?;
+    if odometry {
+        eprintln!("warning: {name}: no reference poses; mapping with the odometry poses");
+    }
+    let mut sweeps = Vec::with_capacity(poses.len());
+    for (i, pose) in poses.iter().enumerate() {
+        let cloud = sequence.sweep(i).map_err(|e| e.to_string())?;
         sweeps.push(Sweep3 {
-            pose,
-            cloud: scan.points,
+            pose: *pose,
+            cloud,
             step,
         });
-    }
-    spatial(dir, sweeps, config)
-}
-
-fn read_nclt(dir: &Path, step: usize, config: &MappingConfig) -> Result<Input, String> {
-    let session = NcltSession::open(dir).map_err(|e| e.to_string())?;
-    let truth = session.ground_truth().map_err(|e| e.to_string())?;
-    if truth.poses.is_empty() {
-        return Err(format!(
-            "{}: the NCLT session has no ground truth (groundtruth_<date>.csv): map building \
-             needs poses",
-            dir.display()
-        ));
-    }
-    let mut sweeps = Vec::new();
-    for scan in session.scans() {
-        let mut scan = scan.map_err(|e| e.to_string())?;
-        let nearest = truth
-            .poses
-            .partition_point(|p| p.utime < scan.utime)
-            .min(truth.poses.len() - 1);
-        let before = nearest.saturating_sub(1);
-        let pick = [before, nearest]
-            .into_iter()
-            .filter_map(|i| truth.poses.get(i))
-            .min_by_key(|p| p.utime.abs_diff(scan.utime));
-        let Some(pose) = pick else { continue };
-        nclt::flu_from_frd(&mut scan.points);
-        sweeps.push(Sweep3 {
-            pose: pose.world_from_body(),
-            cloud: scan.points,
-            step,
-        });
-    }
-    spatial(dir, sweeps, config)
-}
-
-fn spatial(dir: &Path, sweeps: Vec<Sweep3>, config: &MappingConfig) -> Result<Input, String> {
-    if sweeps.is_empty() {
-        return Err(format!(
-            "{}: no velodyne scans to map (velodyne/*.bin or velodyne_sync/*.bin)",
-            dir.display()
-        ));
     }
     let max_range = config.range.max_range_m;
     let mut bounds = Aabb3::empty();
-    for sweep in &sweeps {
+    for (i, sweep) in sweeps.iter().enumerate() {
         if !sweep.pose.is_finite() {
-            return Err(format!("{}: a scan pose is not finite", dir.display()));
+            return Err(format!("{name}: the pose of sweep {i} is not finite"));
         }
         bounds.extend(&sweep.pose.transform_point(&Point3::origin()));
         sweep.for_each_ray(&mut |ray| {
@@ -200,5 +177,15 @@ fn spatial(dir: &Path, sweeps: Vec<Sweep3>, config: &MappingConfig) -> Result<In
             }
         });
     }
-    Ok(Input::Spatial { sweeps, bounds })
+    let stamps = sequence
+        .stamps_secs
+        .iter()
+        .take(sweeps.len())
+        .copied()
+        .collect();
+    Ok(Input::Spatial {
+        sweeps,
+        stamps,
+        bounds,
+    })
 }

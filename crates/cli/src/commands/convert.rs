@@ -1,0 +1,90 @@
+//! `raypath convert`: between CARMEN logs, the KITTI layout, PCD files and rosbag2 bags, so
+//! the public benchmark logs become bags and back (`raypath_io::convert`).
+
+use std::path::PathBuf;
+
+use raypath_io::convert::{ConvertOptions, Target, convert};
+use raypath_io::rosbag::{BagCompression, BagWriteOptions};
+
+use super::Failure;
+use super::source_args::SourceArgs;
+
+/// Chunk compression of a written bag.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Compression {
+    /// zstd (rosbag2's default for compressed MCAP).
+    #[default]
+    Zstd,
+    /// LZ4 frames.
+    Lz4,
+    /// No compression.
+    None,
+}
+
+/// Arguments of `raypath convert`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The input: a CARMEN log, a KITTI sequence, an NCLT session, a PCD file, or a rosbag2
+    /// bag (a directory with metadata.yaml, or an .mcap file).
+    pub input: PathBuf,
+    /// The output: `.mcap` (a rosbag2 file), `.log`/`.clf` (CARMEN), `.pcd`, or a directory
+    /// (KITTI layout for 3-D input, a rosbag2 bag directory for planar input); `--to` decides
+    /// when the name does not.
+    pub output: PathBuf,
+    /// The output format.
+    #[arg(long, value_name = "FORMAT", value_parser = ["carmen", "kitti", "pcd", "rosbag2"])]
+    pub to: Option<String>,
+    /// Chunk compression of a written bag.
+    #[arg(long, value_enum, default_value_t = Compression::Zstd)]
+    pub compression: Compression,
+    /// Print one JSON object (keys: from, to, frames, reference_poses, output).
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub source: SourceArgs,
+}
+
+/// Runs `raypath convert`.
+pub fn run(args: &Args) -> Result<(), Failure> {
+    let target = args
+        .to
+        .as_deref()
+        .map(str::parse::<Target>)
+        .transpose()
+        .map_err(|e| Failure::input(e, args.json))?;
+    let options = ConvertOptions {
+        target,
+        planar: args.source.planar_options(),
+        sweeps: args.source.sweep_options(),
+        bag: BagWriteOptions {
+            compression: match args.compression {
+                Compression::Zstd => BagCompression::Zstd,
+                Compression::Lz4 => BagCompression::Lz4,
+                Compression::None => BagCompression::None,
+            },
+            ..BagWriteOptions::default()
+        },
+    };
+    let report =
+        convert(&args.input, &args.output, &options).map_err(|e| Failure::input(e, args.json))?;
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string(&report).map_err(|e| Failure::input(e, true))?
+        );
+    } else {
+        println!(
+            "{} ({}) → {} ({}): {} frames, {} with reference poses",
+            args.input.display(),
+            report.from,
+            report.output.display(),
+            serde_json::to_value(report.to)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_owned))
+                .unwrap_or_default(),
+            report.frames,
+            report.reference_poses
+        );
+    }
+    Ok(())
+}

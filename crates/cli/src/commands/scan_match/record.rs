@@ -1,0 +1,96 @@
+//! `raypath scan-match --record`: the scans at their estimated poses, the trajectory, and the
+//! finest map level as occupancy and reflectivity Grids.
+
+use raypath_geometry::Pose2;
+use raypath_io::foxglove::{GridLayer, GridValues, frame, topic};
+use raypath_io::sequence::PlanarFrame;
+use raypath_reflectivity::{GridLevel, probability};
+
+use crate::commands::Failure;
+use crate::commands::record::Recording;
+
+/// Cells kept around the observed part of the map.
+const MARGIN: usize = 10;
+
+/// Writes every scan at its estimate `world_from_laser` (`/tf` `map → base_link`, `/scan` in
+/// `base_link` with the logged mounting), the robot's `/trajectory`, and, from `level`, the
+/// occupancy probability as `/map` and the mean relative reflectivity as `/reflectivity`
+/// (`FLOAT32`, NaN where unobserved), cropped to the observed cells plus a margin.
+pub fn record(
+    recording: &mut Recording,
+    scans: &[PlanarFrame],
+    poses: &[Pose2],
+    level: Option<&GridLevel>,
+) -> Result<(), Failure> {
+    let mut robots = Vec::with_capacity(poses.len());
+    for (frame, world_from_laser) in scans.iter().zip(poses) {
+        let robot_from_laser = frame.robot_from_laser();
+        let world_from_robot = *world_from_laser * robot_from_laser.inverse();
+        recording.planar_scan(
+            frame.stamp_secs,
+            &world_from_robot,
+            &robot_from_laser,
+            &frame.scan,
+        )?;
+        robots.push(world_from_robot);
+    }
+    let end = recording.end_stamp();
+    recording.planar_trajectory(topic::TRAJECTORY, end, &robots)?;
+    let Some(level) = level else {
+        return Ok(());
+    };
+    let Some([i0, j0, i1, j1]) = observed_box(level) else {
+        return Ok(());
+    };
+    let cells = || (j0..j1).flat_map(|j| (i0..i1).map(move |i| (i, j)));
+    let occupancy: Vec<f32> = cells()
+        .map(|(i, j)| match level.log_odds(i, j) {
+            0.0 => f32::NAN,
+            l => probability(l) as f32,
+        })
+        .collect();
+    let resolution = level.resolution_m();
+    let [x, y] = level.origin();
+    let mut layer = GridLayer {
+        frame_id: frame::MAP,
+        origin: Pose2::new(x + i0 as f64 * resolution, y + j0 as f64 * resolution, 0.0).to_pose3(),
+        cell_size_m: resolution,
+        columns: i1 - i0,
+        rows: j1 - j0,
+        field: "occupancy",
+        values: GridValues::F32(&occupancy),
+    };
+    recording.grid_layer(topic::MAP, end, &layer)?;
+    if level.has_reflectivity() {
+        let reflectivity: Vec<f32> = cells()
+            .map(|(i, j)| level.cell_reflectivity(i, j).map_or(f32::NAN, |(m, _)| m))
+            .collect();
+        layer.field = "reflectivity";
+        layer.values = GridValues::F32(&reflectivity);
+        recording.grid_layer(topic::REFLECTIVITY, end, &layer)?;
+    }
+    Ok(())
+}
+
+/// The index box `[i0, j0, i1, j1)` of the cells with non-zero log-odds plus [`MARGIN`].
+fn observed_box(level: &GridLevel) -> Option<[usize; 4]> {
+    let (mut i0, mut j0, mut i1, mut j1) = (usize::MAX, usize::MAX, 0, 0);
+    for j in 0..level.height() {
+        for i in 0..level.width() {
+            if level.log_odds(i, j) != 0.0 {
+                i0 = i0.min(i);
+                j0 = j0.min(j);
+                i1 = i1.max(i + 1);
+                j1 = j1.max(j + 1);
+            }
+        }
+    }
+    (i1 > 0).then(|| {
+        [
+            i0.saturating_sub(MARGIN),
+            j0.saturating_sub(MARGIN),
+            (i1 + MARGIN).min(level.width()),
+            (j1 + MARGIN).min(level.height()),
+        ]
+    })
+}
