@@ -10,9 +10,7 @@ use serde_json::Value;
 mod common;
 mod record_common;
 use common::{json_of, raypath};
-use record_common::{
-    SCANS, T0, expect_topics, first, grid_cells, read_recording, room_log, room_pose, s, xy,
-};
+use record_common::{SCANS, T0, along, grid_cells, record, room_log, room_pose, s, xy};
 
 /// The keys of a JSON object.
 fn keys(doc: &Value) -> Vec<String> {
@@ -23,31 +21,12 @@ fn keys(doc: &Value) -> Vec<String> {
 fn map_records_scans_trajectory_and_map() {
     let dir = tempfile::tempdir().unwrap();
     let log = room_log(dir.path());
-    let mcap = dir.path().join("rec/map.mcap");
-    let args = |record: bool| {
-        let mut a = vec![
-            "map".to_owned(),
-            s(&log).to_owned(),
-            "--model".into(),
-            "reflection".into(),
-            "--resolution".into(),
-            "0.1".into(),
-            "--out".into(),
-            s(&dir.path().join("room")).to_owned(),
-            "--json".into(),
-        ];
-        if record {
-            a.extend(["--record".to_owned(), s(&mcap).to_owned()]);
-        }
-        a
-    };
-    let plain = json_of(&raypath(
-        &args(false).iter().map(String::as_str).collect::<Vec<_>>(),
-    ));
+    let out = dir.path().join("room");
+    let grid = ["--model", "reflection", "--resolution", "0.1"];
+    let args = [&["map", s(&log), "--out", s(&out)][..], &grid].concat();
+    let plain = json_of(&raypath(&[&args[..], &["--json"]].concat()));
     assert!(plain.get("record").is_none());
-    let doc = json_of(&raypath(
-        &args(true).iter().map(String::as_str).collect::<Vec<_>>(),
-    ));
+    let (doc, rec) = record(&args, dir.path().join("rec/map.mcap"));
     // The document keeps every key and value (but the timings) and gains `record`.
     let mut with: Vec<String> = keys(&plain);
     with.push("record".into());
@@ -57,17 +36,7 @@ fn map_records_scans_trajectory_and_map() {
         assert_eq!(doc[key], plain[key], "{key}");
     }
 
-    let rec = read_recording(&mcap);
-    expect_topics(
-        &rec,
-        &[
-            ("/tf", "FrameTransform", SCANS),
-            ("/scan", "LaserScan", SCANS),
-            ("/trajectory", "PosesInFrame", 1),
-            ("/map", "Grid", 1),
-        ],
-        Some((&doc, &mcap)),
-    );
+    rec.expect_topics(&doc, &along("/scan", SCANS, "/map"));
     // Scan k at its stamp and pose; the laser sits on the robot (no mount offset).
     for (k, (time, tf)) in rec["/tf"].messages.iter().enumerate() {
         let expected = (T0 + 0.1 * k as f64) * 1e9;
@@ -81,15 +50,15 @@ fn map_records_scans_trajectory_and_map() {
         assert_eq!(tf["parent_frame_id"], "map");
         assert_eq!(tf["child_frame_id"], "base_link");
     }
-    let scan = first(&rec, "/scan");
+    let scan = rec.first("/scan");
     assert_eq!(scan["frame_id"], "base_link");
     assert_eq!(scan["ranges"].as_array().unwrap().len(), 181);
     assert_eq!(scan["pose"]["position"]["x"], 0.0);
-    let poses = first(&rec, "/trajectory")["poses"].as_array().unwrap();
+    let poses = rec.first("/trajectory")["poses"].as_array().unwrap();
     assert_eq!(poses.len(), SCANS);
     // The map: the command's grid, reflection probabilities in [0, 1] (NaN unknown), walls
     // reflecting, the open room not.
-    let map = first(&rec, "/map");
+    let map = rec.first("/map");
     assert_eq!(map["fields"][0]["name"], "reflection");
     let (columns, rows, cells) = grid_cells(map);
     assert_eq!(doc["grid"], serde_json::json!([columns, rows]));
@@ -124,8 +93,7 @@ fn localize_records_map_estimates_and_ground_truth() {
         "--json",
     ]));
     let map = dir.path().join("room.rpmap");
-    let mcap = dir.path().join("localize.mcap");
-    let doc = json_of(&raypath(&[
+    let args = [
         "localize",
         "--map",
         s(&map),
@@ -135,35 +103,24 @@ fn localize_records_map_estimates_and_ground_truth() {
         s(&log),
         "--particles",
         "200",
-        "--record",
-        s(&mcap),
-        "--json",
-    ]));
+    ];
+    let (doc, rec) = record(&args, dir.path().join("localize.mcap"));
     assert!(!doc["error"].is_null(), "{doc}");
-    let rec = read_recording(&mcap);
     let estimates = rec["/tf"].messages.len();
     assert!(estimates >= 2, "{estimates}");
-    expect_topics(
-        &rec,
-        &[
-            ("/map", "Grid", 1),
-            ("/tf", "FrameTransform", estimates),
-            ("/scan", "LaserScan", estimates),
-            ("/trajectory", "PosesInFrame", 1),
-            ("/ground_truth", "PosesInFrame", 1),
-        ],
-        Some((&doc, &mcap)),
-    );
+    let mut topics = along("/scan", estimates, "/map");
+    topics.push(("/ground_truth", 1));
+    rec.expect_topics(&doc, &topics);
     // The map is there from the first scan on; the last estimate is the final pose.
     assert_eq!(rec["/map"].messages[0].0, (T0 * 1e9) as u64);
-    assert_eq!(first(&rec, "/map")["fields"][0]["name"], "hit_probability");
-    let poses = first(&rec, "/trajectory")["poses"].as_array().unwrap();
+    assert_eq!(rec.first("/map")["fields"][0]["name"], "hit_probability");
+    let poses = rec.first("/trajectory")["poses"].as_array().unwrap();
     assert_eq!(poses.len(), estimates);
     let (x, y) = xy(&poses[estimates - 1]["position"]);
     let final_pose = &doc["final_pose"];
     assert!((x - final_pose[0].as_f64().unwrap()).abs() < 1e-9);
     assert!((y - final_pose[1].as_f64().unwrap()).abs() < 1e-9);
-    let truth = first(&rec, "/ground_truth")["poses"].as_array().unwrap();
+    let truth = rec.first("/ground_truth")["poses"].as_array().unwrap();
     assert_eq!(truth.len(), SCANS);
     let [x, y, _] = room_pose(SCANS - 1);
     let (tx, ty) = xy(&truth[SCANS - 1]["position"]);
@@ -174,30 +131,11 @@ fn localize_records_map_estimates_and_ground_truth() {
 fn scan_match_records_scans_trajectory_and_occupancy() {
     let dir = tempfile::tempdir().unwrap();
     let log = room_log(dir.path());
-    let mcap = dir.path().join("scan-match.mcap");
-    let doc = json_of(&raypath(&[
-        "scan-match",
-        s(&log),
-        "--odometry",
-        "--size",
-        "20",
-        "--record",
-        s(&mcap),
-        "--json",
-    ]));
-    let rec = read_recording(&mcap);
+    let args = ["scan-match", s(&log), "--odometry", "--size", "20"];
+    let (doc, rec) = record(&args, dir.path().join("scan-match.mcap"));
     // No remissions: no reflectivity layer.
-    expect_topics(
-        &rec,
-        &[
-            ("/tf", "FrameTransform", SCANS),
-            ("/scan", "LaserScan", SCANS),
-            ("/trajectory", "PosesInFrame", 1),
-            ("/map", "Grid", 1),
-        ],
-        Some((&doc, &mcap)),
-    );
-    let map = first(&rec, "/map");
+    rec.expect_topics(&doc, &along("/scan", SCANS, "/map"));
+    let map = rec.first("/map");
     assert_eq!(map["fields"][0]["name"], "occupancy");
     assert!((map["cell_size"]["x"].as_f64().unwrap() - 0.05).abs() < 1e-12);
     let (_, _, cells) = grid_cells(map);
@@ -205,7 +143,7 @@ fn scan_match_records_scans_trajectory_and_occupancy() {
     assert!(known.iter().all(|v| (0.0..=1.0).contains(v)));
     assert!(known.iter().any(|v| *v > 0.65) && known.iter().any(|v| *v < 0.2));
     // The map frame starts at the first scan.
-    let (x, y) = xy(&first(&rec, "/tf")["translation"]);
+    let (x, y) = xy(&rec.first("/tf")["translation"]);
     assert!(x.abs() < 1e-9 && y.abs() < 1e-9);
 }
 
@@ -214,25 +152,8 @@ fn polylines_records_scans_and_line_strips_and_reports_in_text() {
     let dir = tempfile::tempdir().unwrap();
     let log = room_log(dir.path());
     let mcap = dir.path().join("polylines.mcap");
-    let doc = json_of(&raypath(&[
-        "polylines",
-        s(&log),
-        "--scans",
-        "0,5",
-        "--record",
-        s(&mcap),
-        "--json",
-    ]));
-    let rec = read_recording(&mcap);
-    expect_topics(
-        &rec,
-        &[
-            ("/tf", "FrameTransform", 2),
-            ("/scan", "LaserScan", 2),
-            ("/polylines", "SceneUpdate", 2),
-        ],
-        Some((&doc, &mcap)),
-    );
+    let (doc, rec) = record(&["polylines", s(&log), "--scans", "0,5"], mcap.clone());
+    rec.expect_topics(&doc, &[("/tf", 2), ("/scan", 2), ("/polylines", 2)]);
     // Each scan's polylines, in base_link (= the laser frame here), vertex for vertex.
     for (i, (time, update)) in rec["/polylines"].messages.iter().enumerate() {
         let index = doc["scans"][i]["index"].as_u64().unwrap();
@@ -269,8 +190,7 @@ fn polylines_records_scans_and_line_strips_and_reports_in_text() {
 fn dct_map_records_the_map_and_the_baseline() {
     let dir = tempfile::tempdir().unwrap();
     let log = room_log(dir.path());
-    let mcap = dir.path().join("dct.mcap");
-    let doc = json_of(&raypath(&[
+    let args = [
         "dct-map",
         s(&log),
         "--patch=-2,-2,4,4",
@@ -278,40 +198,26 @@ fn dct_map_records_the_map_and_the_baseline() {
         "4,4",
         "--rays",
         "2000",
-        "--record",
-        s(&mcap),
-        "--json",
-    ]));
-    let rec = read_recording(&mcap);
-    expect_topics(
-        &rec,
-        &[
-            ("/map", "Grid", 1),
-            ("/baseline", "Grid", 1),
-            ("/trajectory", "PosesInFrame", 1),
-        ],
-        Some((&doc, &mcap)),
-    );
+    ];
+    let (doc, rec) = record(&args, dir.path().join("dct.mcap"));
+    rec.expect_topics(&doc, &[("/map", 1), ("/baseline", 1), ("/trajectory", 1)]);
     let last = ((T0 + 0.1 * (SCANS - 1) as f64) * 1e9) as u64;
     assert!(rec["/map"].messages[0].0.abs_diff(last) < 1000);
     // The DCT map on 5 cm cells over the 4 m patch; the baseline 4 × 4 cells of 1 m.
-    let map = first(&rec, "/map");
+    let map = rec.first("/map");
     assert_eq!(map["fields"][0]["name"], "decay_rate");
     assert_eq!(xy(&map["pose"]["position"]), (-2.0, -2.0));
     let (columns, rows, rates) = grid_cells(map);
     assert_eq!((columns, rows), (80, 80));
     assert!(rates.iter().all(|r| r.is_finite() && *r >= 0.0));
-    let baseline = first(&rec, "/baseline");
+    let baseline = rec.first("/baseline");
     assert_eq!(xy(&baseline["pose"]["position"]), (-2.0, -2.0));
     let (columns, rows, rates) = grid_cells(baseline);
     assert_eq!((columns, rows), (4, 4));
     assert!((baseline["cell_size"]["x"].as_f64().unwrap() - 1.0).abs() < 1e-12);
     assert!(rates.iter().all(|r| r.is_finite() && *r > 0.0));
     assert_eq!(
-        first(&rec, "/trajectory")["poses"]
-            .as_array()
-            .unwrap()
-            .len(),
+        rec.first("/trajectory")["poses"].as_array().unwrap().len(),
         SCANS
     );
 }
@@ -320,8 +226,7 @@ fn dct_map_records_the_map_and_the_baseline() {
 fn loop_closure_records_the_trajectory_and_the_loops() {
     let dir = tempfile::tempdir().unwrap();
     let log = room_log(dir.path());
-    let mcap = dir.path().join("loops.mcap");
-    let doc = json_of(&raypath(&[
+    let args = [
         "loop-closure",
         s(&log),
         "--method",
@@ -329,24 +234,13 @@ fn loop_closure_records_the_trajectory_and_the_loops() {
         "--exclusion-frames",
         "6",
         "--no-temporal-consistency",
-        "--record",
-        s(&mcap),
-        "--json",
-    ]));
+    ];
+    let (doc, rec) = record(&args, dir.path().join("loops.mcap"));
     let loops = doc["loops"].as_array().unwrap();
     assert!(!loops.is_empty(), "{doc}");
-    let rec = read_recording(&mcap);
-    expect_topics(
-        &rec,
-        &[
-            ("/tf", "FrameTransform", SCANS),
-            ("/trajectory", "PosesInFrame", 1),
-            ("/loops", "SceneUpdate", 1),
-        ],
-        Some((&doc, &mcap)),
-    );
+    rec.expect_topics(&doc, &[("/tf", SCANS), ("/trajectory", 1), ("/loops", 1)]);
     // One segment per loop, from the query's pose to the match's.
-    let line = &first(&rec, "/loops")["entities"][0]["lines"][0];
+    let line = &rec.first("/loops")["entities"][0]["lines"][0];
     assert_eq!(line["type"], 2, "LINE_LIST");
     let points = line["points"].as_array().unwrap();
     assert_eq!(points.len(), 2 * loops.len());

@@ -17,8 +17,8 @@ use serde_json::{Value, json};
 
 mod common;
 mod record_common;
-use common::{json_of, raypath};
-use record_common::{cloud_points, expect_topics, first, grid_cells, read_recording, s, xy};
+use common::raypath;
+use record_common::{along, cloud_points, grid_cells, record, s, xy};
 
 /// Scans of the simulated drive.
 const DRIVE_SCANS: usize = 12;
@@ -68,31 +68,12 @@ fn poles_extract_map_and_localize_record_poles_and_trajectories() {
     let seq = drive(dir.path());
     let csv = dir.path().join("poles.csv");
 
-    let mcap = dir.path().join("map.mcap");
-    let doc = json_of(&raypath(&[
-        "poles",
-        "map",
-        s(&seq),
-        "--out",
-        s(&csv),
-        "--record",
-        s(&mcap),
-        "--json",
-    ]));
+    let args = ["poles", "map", s(&seq), "--out", s(&csv)];
+    let (doc, rec) = record(&args, dir.path().join("map.mcap"));
     let poles = doc["poles"].as_array().unwrap();
     assert!(!poles.is_empty(), "{doc}");
-    let rec = read_recording(&mcap);
-    expect_topics(
-        &rec,
-        &[
-            ("/tf", "FrameTransform", DRIVE_SCANS),
-            ("/points", "PointCloud", DRIVE_SCANS),
-            ("/trajectory", "PosesInFrame", 1),
-            ("/poles", "SceneUpdate", 1),
-        ],
-        Some((&doc, &mcap)),
-    );
-    check_poles(first(&rec, "/poles"), poles);
+    rec.expect_topics(&doc, &along("/points", DRIVE_SCANS, "/poles"));
+    check_poles(rec.first("/poles"), poles);
     // Each sweep in base_link, thinned to at most MAX_SWEEP_POINTS, with its intensities.
     for (_, sweep) in &rec["/points"].messages {
         assert_eq!(sweep["frame_id"], "base_link");
@@ -110,31 +91,15 @@ fn poles_extract_map_and_localize_record_poles_and_trajectories() {
     assert!(times[DRIVE_SCANS - 1].abs_diff(1_100_000_000) < 1000);
     assert_eq!(rec["/poles"].messages[0].0, times[DRIVE_SCANS - 1]);
 
-    let mcap = dir.path().join("extract.mcap");
-    let doc = json_of(&raypath(&[
-        "poles",
-        "extract",
-        s(&seq),
-        "--record",
-        s(&mcap),
-        "--json",
-    ]));
-    let scans = doc["scans"].as_u64().unwrap() as usize;
-    let rec = read_recording(&mcap);
-    expect_topics(
-        &rec,
-        &[
-            ("/tf", "FrameTransform", scans),
-            ("/points", "PointCloud", scans),
-            ("/trajectory", "PosesInFrame", 1),
-            ("/poles", "SceneUpdate", 1),
-        ],
-        Some((&doc, &mcap)),
+    let (doc, rec) = record(
+        &["poles", "extract", s(&seq)],
+        dir.path().join("extract.mcap"),
     );
-    check_poles(first(&rec, "/poles"), doc["poles"].as_array().unwrap());
+    let scans = doc["scans"].as_u64().unwrap() as usize;
+    rec.expect_topics(&doc, &along("/points", scans, "/poles"));
+    check_poles(rec.first("/poles"), doc["poles"].as_array().unwrap());
 
-    let mcap = dir.path().join("localize.mcap");
-    let doc = json_of(&raypath(&[
+    let args = [
         "poles",
         "localize",
         "--map",
@@ -142,34 +107,23 @@ fn poles_extract_map_and_localize_record_poles_and_trajectories() {
         s(&seq),
         "--runs",
         "2",
-        "--record",
-        s(&mcap),
-        "--json",
-    ]));
+    ];
+    let (doc, rec) = record(&args, dir.path().join("localize.mcap"));
     assert!(!doc["summary"].is_null(), "{doc}");
-    let rec = read_recording(&mcap);
     let estimates = rec["/tf"].messages.len();
     assert!(estimates >= 2);
-    expect_topics(
-        &rec,
-        &[
-            ("/poles", "SceneUpdate", 1),
-            ("/tf", "FrameTransform", estimates),
-            ("/points", "PointCloud", estimates),
-            ("/trajectory", "PosesInFrame", 1),
-            ("/ground_truth", "PosesInFrame", 1),
-        ],
-        Some((&doc, &mcap)),
-    );
+    let mut topics = along("/points", estimates, "/poles");
+    topics.push(("/ground_truth", 1));
+    rec.expect_topics(&doc, &topics);
     // The map from the start; the first run's estimates; the ground truth of every scan.
     assert_eq!(rec["/poles"].messages[0].0, 0);
     assert_eq!(
-        first(&rec, "/poles")["entities"].as_array().unwrap().len(),
+        rec.first("/poles")["entities"].as_array().unwrap().len(),
         poles.len()
     );
-    let trajectory = first(&rec, "/trajectory")["poses"].as_array().unwrap();
+    let trajectory = rec.first("/trajectory")["poses"].as_array().unwrap();
     assert_eq!(trajectory.len(), estimates);
-    let truth = first(&rec, "/ground_truth")["poses"].as_array().unwrap();
+    let truth = rec.first("/ground_truth")["poses"].as_array().unwrap();
     assert_eq!(truth.len(), DRIVE_SCANS);
 }
 
@@ -177,8 +131,8 @@ fn poles_extract_map_and_localize_record_poles_and_trajectories() {
 fn a_3d_map_records_sweep_poses_and_occupied_voxels() {
     let dir = tempfile::tempdir().unwrap();
     let seq = drive(dir.path());
-    let mcap = dir.path().join("map3d.mcap");
-    let doc = json_of(&raypath(&[
+    let out = dir.path().join("map3d");
+    let args = [
         "map",
         s(&seq),
         "--model",
@@ -190,32 +144,21 @@ fn a_3d_map_records_sweep_poses_and_occupied_voxels() {
         "--ray-step",
         "8",
         "--out",
-        s(&dir.path().join("map3d")),
-        "--record",
-        s(&mcap),
-        "--json",
-    ]));
-    let rec = read_recording(&mcap);
-    expect_topics(
-        &rec,
-        &[
-            ("/tf", "FrameTransform", DRIVE_SCANS),
-            ("/points", "PointCloud", DRIVE_SCANS),
-            ("/trajectory", "PosesInFrame", 1),
-            ("/map", "Grid", 1),
-            ("/map_points", "PointCloud", 1),
-        ],
-        Some((&doc, &mcap)),
-    );
+        s(&out),
+    ];
+    let (doc, rec) = record(&args, dir.path().join("map3d.mcap"));
+    let mut topics = along("/points", DRIVE_SCANS, "/map");
+    topics.push(("/map_points", 1));
+    rec.expect_topics(&doc, &topics);
     // The column-sum picture over the map's x-y cells.
-    let (columns, rows, cells) = grid_cells(first(&rec, "/map"));
+    let (columns, rows, cells) = grid_cells(rec.first("/map"));
     assert_eq!(
         json!([columns, rows]),
         json!([doc["grid"][0], doc["grid"][1]])
     );
     assert!(cells.iter().any(|v| !v.is_nan()));
     // Occupied voxel centres inside the map, occupancy above one half.
-    let points = cloud_points(first(&rec, "/map_points"));
+    let points = cloud_points(rec.first("/map_points"));
     assert!(!points.is_empty());
     let (min, max) = (&doc["extent"]["min"], &doc["extent"]["max"]);
     for p in &points {
@@ -240,32 +183,15 @@ fn octree_records_occupied_leaves_as_points_and_cubes() {
     }
     let points = dir.path().join("wall.xyz");
     std::fs::write(&points, text).unwrap();
-    let mcap = dir.path().join("octree.mcap");
-    let doc = json_of(&raypath(&[
-        "octree",
-        s(&points),
-        "--resolution",
-        "0.2",
-        "--record",
-        s(&mcap),
-        "--json",
-    ]));
+    let args = ["octree", s(&points), "--resolution", "0.2"];
+    let (doc, rec) = record(&args, dir.path().join("octree.mcap"));
     let occupied = doc["occupied_leaves"].as_u64().unwrap() as usize;
     assert!(occupied > 0);
-    let rec = read_recording(&mcap);
-    expect_topics(
-        &rec,
-        &[
-            ("/tf", "FrameTransform", 1),
-            ("/trajectory", "PosesInFrame", 1),
-            ("/map_points", "PointCloud", 1),
-            ("/octree", "SceneUpdate", 1),
-        ],
-        Some((&doc, &mcap)),
-    );
-    let centres = cloud_points(first(&rec, "/map_points"));
+    let topics = ["/tf", "/trajectory", "/map_points", "/octree"];
+    rec.expect_topics(&doc, &topics.map(|t| (t, 1)));
+    let centres = cloud_points(rec.first("/map_points"));
     assert_eq!(centres.len(), occupied);
-    let cubes = first(&rec, "/octree")["entities"][0]["cubes"]
+    let cubes = rec.first("/octree")["entities"][0]["cubes"]
         .as_array()
         .unwrap()
         .clone();
@@ -304,28 +230,12 @@ fn planes_records_the_labelled_cloud_and_the_plane_outlines() {
     let dir = tempfile::tempdir().unwrap();
     let scan = dir.path().join("scene.pcd");
     write_scene(&scan);
-    let mcap = dir.path().join("planes.mcap");
-    let doc = json_of(&raypath(&[
-        "planes",
-        s(&scan),
-        "--record",
-        s(&mcap),
-        "--json",
-    ]));
+    let (doc, rec) = record(&["planes", s(&scan)], dir.path().join("planes.mcap"));
     let planes = doc["planes"].as_array().unwrap();
     assert_eq!(planes.len(), 2, "{doc}");
-    let rec = read_recording(&mcap);
-    expect_topics(
-        &rec,
-        &[
-            ("/tf", "FrameTransform", 1),
-            ("/points", "PointCloud", 1),
-            ("/planes", "SceneUpdate", 1),
-        ],
-        Some((&doc, &mcap)),
-    );
+    rec.expect_topics(&doc, &[("/tf", 1), ("/points", 1), ("/planes", 1)]);
     // Every point, labelled as the planes count them; one colour per label.
-    let points = cloud_points(first(&rec, "/points"));
+    let points = cloud_points(rec.first("/points"));
     assert_eq!(points.len(), 40 * 30);
     for plane in planes {
         let label = plane["label"].as_f64().unwrap();
@@ -335,7 +245,7 @@ fn planes_records_the_labelled_cloud_and_the_plane_outlines() {
         assert!(members.iter().all(|p| rgb(p) == rgb(members[0])));
     }
     // Each outline lies on its fitted plane (n · p = distance).
-    let entities = first(&rec, "/planes")["entities"].as_array().unwrap();
+    let entities = rec.first("/planes")["entities"].as_array().unwrap();
     assert_eq!(entities.len(), 2);
     for (entity, plane) in entities.iter().zip(planes) {
         assert_eq!(entity["id"], format!("plane {}", plane["label"]));
@@ -383,17 +293,9 @@ fn a_poles_map_recording_opens_in_the_python_mcap_reader() {
     }
     let dir = tempfile::tempdir().unwrap();
     let seq = drive(dir.path());
-    let mcap = dir.path().join("poles.mcap");
-    let doc = json_of(&raypath(&[
-        "poles",
-        "map",
-        s(&seq),
-        "--out",
-        s(&dir.path().join("poles.csv")),
-        "--record",
-        s(&mcap),
-        "--json",
-    ]));
+    let csv = dir.path().join("poles.csv");
+    let args = ["poles", "map", s(&seq), "--out", s(&csv)];
+    let (doc, rec) = record(&args, dir.path().join("poles.mcap"));
     let poles = doc["poles"].as_array().unwrap();
     assert!(!poles.is_empty());
     let pole = &poles[0];
@@ -429,7 +331,7 @@ fn a_poles_map_recording_opens_in_the_python_mcap_reader() {
         "/../io/tests/fixtures/check_foxglove.py"
     );
     let out = Command::new("python3")
-        .args([script, s(&mcap), s(&expected_path)])
+        .args([script, s(&rec.path), s(&expected_path)])
         .output()
         .unwrap();
     assert!(

@@ -14,64 +14,13 @@ use raypath_io::sequence::{
     read_planar,
 };
 
+mod common;
+use common::{assert_pose2, assert_pose3, assert_same_scan};
+
 fn opts(compression: BagCompression) -> BagWriteOptions {
     BagWriteOptions {
         compression,
         chunk_size_bytes: 64 * 1024,
-    }
-}
-
-fn assert_pose2(a: &Pose2, b: &Pose2, tol: f64, what: &str) {
-    assert!(
-        (a.x() - b.x()).abs() < tol
-            && (a.y() - b.y()).abs() < tol
-            && raypath_geometry::wrap_angle(a.theta() - b.theta()).abs() < tol,
-        "{what}: {a:?} vs {b:?}"
-    );
-}
-
-fn assert_pose3(a: &Pose3, b: &Pose3, tol: f64, what: &str) {
-    assert!(
-        (a.translation() - b.translation()).norm() < tol
-            && a.rotation().angle_to(&b.rotation()) < tol,
-        "{what}: {a:?} vs {b:?}"
-    );
-}
-
-/// Same scans up to float32 rounding: no-returns where the source has them, ranges and
-/// angles equal to float32 precision.
-fn assert_same_scan(a: &Scan2, b: &Scan2, what: &str) {
-    assert_eq!(a.len(), b.len(), "{what}: beams");
-    assert_eq!(
-        a.max_range_m as f32, b.max_range_m as f32,
-        "{what}: max range"
-    );
-    assert!(
-        (a.angle_min_rad - b.angle_min_rad).abs() < 1e-6,
-        "{what}: angle_min"
-    );
-    assert!(
-        (a.angle_increment_rad - b.angle_increment_rad).abs() < 1e-7,
-        "{what}: increment"
-    );
-    for i in 0..a.len() {
-        match (a.range(i), b.range(i)) {
-            (Range::Hit(x), Range::Hit(y)) => {
-                assert_eq!(x as f32, y as f32, "{what}: beam {i}");
-            }
-            (Range::NoReturn, Range::NoReturn) => {}
-            (x, y) => panic!("{what}: beam {i}: {x:?} vs {y:?}"),
-        }
-    }
-    match (&a.intensities, &b.intensities) {
-        (Some(x), Some(y)) => {
-            assert!(
-                x.iter().zip(y).all(|(p, q)| *p as f32 == *q as f32),
-                "{what}: intensities"
-            )
-        }
-        (None, None) => {}
-        _ => panic!("{what}: intensities present in one only"),
     }
 }
 

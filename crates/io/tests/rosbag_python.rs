@@ -8,13 +8,16 @@
 use std::path::Path;
 use std::process::Command;
 
-use raypath_geometry::{Pose2, Pose3, Range, Scan2};
+use raypath_geometry::{Pose2, Pose3, Scan2};
 use raypath_io::rosbag::{self, BagCompression, BagWriteOptions};
 use raypath_io::sequence::{
     Origin, PlanarFrame, PlanarOptions, SweepFormat, SweepOptions, SweepSequence, Topics,
     read_planar,
 };
 use serde_json::Value;
+
+mod common;
+use common::{assert_pose2, assert_pose3, assert_same_scan};
 
 fn fixture(name: &str) -> String {
     format!("{}/tests/fixtures/{name}", env!("CARGO_MANIFEST_DIR"))
@@ -46,51 +49,6 @@ fn python(args: &[&str]) -> String {
         String::from_utf8_lossy(&out.stderr)
     );
     String::from_utf8(out.stdout).unwrap()
-}
-
-fn assert_pose2(a: &Pose2, b: &Pose2, tol: f64, what: &str) {
-    assert!(
-        (a.x() - b.x()).abs() < tol
-            && (a.y() - b.y()).abs() < tol
-            && raypath_geometry::wrap_angle(a.theta() - b.theta()).abs() < tol,
-        "{what}: {a:?} vs {b:?}"
-    );
-}
-
-fn assert_pose3(a: &Pose3, b: &Pose3, tol: f64, what: &str) {
-    assert!(
-        (a.translation() - b.translation()).norm() < tol
-            && a.rotation().angle_to(&b.rotation()) < tol,
-        "{what}: {a:?} vs {b:?}"
-    );
-}
-
-fn assert_same_scan(log: &Scan2, bag: &Scan2, what: &str) {
-    assert_eq!(log.len(), bag.len(), "{what}");
-    assert_eq!(
-        log.max_range_m as f32, bag.max_range_m as f32,
-        "{what}: range_max"
-    );
-    assert!(
-        (log.angle_min_rad - bag.angle_min_rad).abs() < 1e-6,
-        "{what}"
-    );
-    assert!(
-        (log.angle_increment_rad - bag.angle_increment_rad).abs() < 1e-7,
-        "{what}"
-    );
-    for i in 0..log.len() {
-        match (log.range(i), bag.range(i)) {
-            (Range::Hit(a), Range::Hit(b)) => assert_eq!(a as f32, b as f32, "{what}: beam {i}"),
-            (Range::NoReturn, Range::NoReturn) => {}
-            (a, b) => panic!("{what}: beam {i}: {a:?} vs {b:?}"),
-        }
-    }
-    assert_eq!(
-        log.intensities.is_some(),
-        bag.intensities.is_some(),
-        "{what}"
-    );
 }
 
 #[test]

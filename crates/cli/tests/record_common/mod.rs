@@ -1,13 +1,16 @@
-//! Helpers of the `--record` tests: a synthetic CARMEN log, and a recording read back with the
-//! `mcap` crate (summary and every message, decoded as JSON).
+//! Helpers of the `--record` tests: a synthetic CARMEN log, a command run with `--record`, and
+//! its recording read back with the `mcap` crate (summary and every message, decoded as JSON).
 #![allow(dead_code, clippy::unwrap_used, clippy::expect_used)] // not every test uses all
 
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
 use std::fmt::Write as _;
+use std::ops::Index;
 use std::path::{Path, PathBuf};
 
 use serde_json::Value;
+
+use crate::common::{json_of, raypath};
 
 /// The path as a `&str` for the command line.
 pub fn s(path: &Path) -> &str {
@@ -80,12 +83,38 @@ pub struct Topic {
     pub messages: Vec<(u64, Value)>,
 }
 
+/// A recording read back: its path and its topics by name (`recording["/tf"]`).
+#[derive(Debug)]
+pub struct Recording {
+    /// The `.mcap` file.
+    pub path: PathBuf,
+    /// Every topic by name.
+    pub topics: BTreeMap<String, Topic>,
+}
+
+impl Index<&str> for Recording {
+    type Output = Topic;
+
+    fn index(&self, topic: &str) -> &Topic {
+        &self.topics[topic]
+    }
+}
+
+/// Runs `raypath ARGS --record MCAP --json`: the command's JSON document and its recording
+/// read back with [`read_recording`].
+pub fn record(args: &[&str], mcap: PathBuf) -> (Value, Recording) {
+    let mut all = args.to_vec();
+    all.extend(["--record", s(&mcap), "--json"]);
+    let doc = json_of(&raypath(&all));
+    (doc, read_recording(mcap))
+}
+
 /// Reads a recording and checks what every Foxglove recording must be: a summary whose message
 /// counts match the messages read, schemas named `foxglove.*` with encoding `jsonschema` and a
 /// JSON Schema text titled with the name, channels of encoding `json`, and each message's log
 /// time equal to its `timestamp`.
-pub fn read_recording(path: &Path) -> BTreeMap<String, Topic> {
-    let bytes = std::fs::read(path).expect("the recording exists");
+pub fn read_recording(path: PathBuf) -> Recording {
+    let bytes = std::fs::read(&path).expect("the recording exists");
     let summary = mcap::Summary::read(&bytes)
         .expect("a readable summary")
         .expect("a summary");
@@ -127,7 +156,7 @@ pub fn read_recording(path: &Path) -> BTreeMap<String, Topic> {
     for topic in topics.values_mut() {
         topic.messages.sort_by_key(|(t, _)| *t);
     }
-    topics
+    Recording { path, topics }
 }
 
 fn stamp_nanos(message: &Value) -> Option<u64> {
@@ -137,39 +166,54 @@ fn stamp_nanos(message: &Value) -> Option<u64> {
     Some(stamp["sec"].as_u64()? * 1_000_000_000 + stamp["nsec"].as_u64()?)
 }
 
-/// Checks the topics, their schemas and message counts exactly, and that the command's JSON
-/// `record` key names `path` and the same counts.
-pub fn expect_topics(
-    recording: &BTreeMap<String, Topic>,
-    expected: &[(&str, &str, usize)],
-    doc: Option<(&Value, &Path)>,
-) {
-    let got: Vec<(String, String, usize)> = recording
-        .iter()
-        .map(|(t, topic)| (t.clone(), topic.schema.clone(), topic.messages.len()))
-        .collect();
-    let mut want: Vec<(String, String, usize)> = expected
-        .iter()
-        .map(|(t, s, n)| (t.to_string(), format!("foxglove.{s}"), *n))
-        .collect();
-    want.sort();
-    assert_eq!(got, want);
-    if let Some((doc, path)) = doc {
-        let record = &doc["record"];
-        assert_eq!(record["path"], s(path), "{doc}");
-        let counts: BTreeMap<String, usize> =
-            serde_json::from_value(record["messages"].clone()).unwrap();
-        let want: BTreeMap<String, usize> = expected
-            .iter()
-            .map(|(t, _, n)| (t.to_string(), *n))
-            .collect();
-        assert_eq!(counts, want);
+/// The topics of a recording along a trajectory: `n` transforms and `n` messages of `sensor`,
+/// the trajectory, and one message of `result`.
+pub fn along(sensor: &'static str, n: usize, result: &'static str) -> Vec<(&'static str, usize)> {
+    vec![("/tf", n), (sensor, n), ("/trajectory", 1), (result, 1)]
+}
+
+/// The Foxglove schema (`foxglove.` left off) the commands record each topic with.
+fn schema_of(topic: &str) -> &'static str {
+    match topic {
+        "/tf" => "FrameTransform",
+        "/scan" => "LaserScan",
+        "/points" | "/map_points" => "PointCloud",
+        "/trajectory" | "/ground_truth" => "PosesInFrame",
+        "/map" | "/baseline" => "Grid",
+        "/polylines" | "/loops" | "/poles" | "/octree" | "/planes" => "SceneUpdate",
+        other => panic!("no schema known for {other}"),
     }
 }
 
-/// The first message of `topic`.
-pub fn first<'a>(recording: &'a BTreeMap<String, Topic>, topic: &str) -> &'a Value {
-    &recording[topic].messages[0].1
+impl Recording {
+    /// Checks the topics and their message counts exactly, each topic's schema against
+    /// [`schema_of`], and that the command's JSON `record` key names this file and the same
+    /// counts.
+    pub fn expect_topics(&self, doc: &Value, expected: &[(&str, usize)]) {
+        let got: Vec<(String, String, usize)> = self
+            .topics
+            .iter()
+            .map(|(t, topic)| (t.clone(), topic.schema.clone(), topic.messages.len()))
+            .collect();
+        let mut want: Vec<(String, String, usize)> = expected
+            .iter()
+            .map(|(t, n)| (t.to_string(), format!("foxglove.{}", schema_of(t)), *n))
+            .collect();
+        want.sort();
+        assert_eq!(got, want);
+        let record = &doc["record"];
+        assert_eq!(record["path"], s(&self.path), "{doc}");
+        let counts: BTreeMap<String, usize> =
+            serde_json::from_value(record["messages"].clone()).unwrap();
+        let want: BTreeMap<String, usize> =
+            expected.iter().map(|(t, n)| (t.to_string(), *n)).collect();
+        assert_eq!(counts, want);
+    }
+
+    /// The first message of `topic`.
+    pub fn first(&self, topic: &str) -> &Value {
+        &self[topic].messages[0].1
+    }
 }
 
 /// Decodes standard base64 (with padding).
