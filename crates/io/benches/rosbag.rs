@@ -9,8 +9,10 @@
 //! * `sweeps`: 1 000 `PointCloud2` sweeps of 120 000 points (x, y, z, intensity float32) with
 //!   `/tf`, read through `rosbag::open_sweeps` and `sweep(i)` for every sweep.
 //!
-//! Each in zstd-compressed and uncompressed chunks. Run with
-//! `cargo bench -p raypath-io --bench rosbag -- --sample-size 10`.
+//! Each in zstd-compressed, LZ4-compressed and uncompressed chunks. Run with
+//! `cargo bench -p raypath-io --bench rosbag -- --sample-size 10`. With `RAYPATH_BENCH_BAGS`
+//! set to a directory the bags are kept there and reused by later runs (for profiling:
+//! `perf record <bench binary> --bench --profile-time 10 planar_100k_scans/Zstd`).
 #![allow(clippy::unwrap_used)]
 
 use std::hint::black_box;
@@ -32,7 +34,7 @@ const SWEEPS: usize = 1_000;
 const POINTS: usize = 120_000;
 
 struct Bags {
-    _dir: tempfile::TempDir,
+    _dir: Option<tempfile::TempDir>,
     planar: Vec<(BagCompression, PathBuf)>,
     sweeps: Vec<(BagCompression, PathBuf)>,
 }
@@ -119,37 +121,55 @@ fn write_sweeps(path: &Path, compression: BagCompression) {
 fn bags() -> &'static Bags {
     static BAGS: OnceLock<Bags> = OnceLock::new();
     BAGS.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
+        let (temp, dir) = match std::env::var_os("RAYPATH_BENCH_BAGS") {
+            Some(d) => {
+                std::fs::create_dir_all(&d).unwrap();
+                (None, PathBuf::from(d))
+            }
+            None => {
+                let t = tempfile::tempdir().unwrap();
+                let d = t.path().to_path_buf();
+                (Some(t), d)
+            }
+        };
         let mut planar = Vec::new();
         let mut sweeps = Vec::new();
-        for compression in [BagCompression::Zstd, BagCompression::None] {
-            let p = dir.path().join(format!("planar-{compression:?}.mcap"));
-            let started = std::time::Instant::now();
-            write_planar(&p, compression);
-            eprintln!(
-                "generated {} ({:.1} MB) in {:.1} s",
-                p.display(),
-                size(&p) as f64 / 1e6,
-                started.elapsed().as_secs_f64()
-            );
+        for compression in [
+            BagCompression::Zstd,
+            BagCompression::Lz4,
+            BagCompression::None,
+        ] {
+            let p = dir.join(format!("planar-{compression:?}.mcap"));
+            generate(&p, |p| write_planar(p, compression), temp.is_none());
             planar.push((compression, p));
-            let s = dir.path().join(format!("sweeps-{compression:?}.mcap"));
-            let started = std::time::Instant::now();
-            write_sweeps(&s, compression);
-            eprintln!(
-                "generated {} ({:.1} MB) in {:.1} s",
-                s.display(),
-                size(&s) as f64 / 1e6,
-                started.elapsed().as_secs_f64()
-            );
+            let s = dir.join(format!("sweeps-{compression:?}.mcap"));
+            generate(&s, |s| write_sweeps(s, compression), temp.is_none());
             sweeps.push((compression, s));
         }
         Bags {
-            _dir: dir,
+            _dir: temp,
             planar,
             sweeps,
         }
     })
+}
+
+/// Writes the bag at `path` (unless `reuse` and it is there: a kept bag, written whole, is
+/// renamed into place last).
+fn generate(path: &Path, write: impl FnOnce(&Path), reuse: bool) {
+    if reuse && path.is_file() {
+        return;
+    }
+    let started = std::time::Instant::now();
+    let partial = path.with_extension("partial.mcap");
+    write(&partial);
+    std::fs::rename(&partial, path).unwrap();
+    eprintln!(
+        "generated {} ({:.1} MB) in {:.1} s",
+        path.display(),
+        size(path) as f64 / 1e6,
+        started.elapsed().as_secs_f64()
+    );
 }
 
 fn size(path: &Path) -> u64 {

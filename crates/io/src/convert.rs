@@ -26,6 +26,7 @@ use std::path::{Path, PathBuf};
 use raypath_geometry::{PointCloud, Pose3};
 use serde::Serialize;
 
+use crate::Format;
 use crate::carmen::{CarmenWriter, FanConvention, LaserKind, LaserMessage, NumberFormat};
 use crate::error::{Error, Location, Result};
 use crate::kitti::{self, KittiCalib};
@@ -34,7 +35,6 @@ use crate::rosbag::{self, BagWriteOptions};
 use crate::sequence::{
     PlanarFrame, PlanarOptions, SweepFormat, SweepOptions, SweepSequence, read_planar,
 };
-use crate::Format;
 
 /// What to write.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
@@ -59,9 +59,7 @@ impl std::str::FromStr for Target {
             "kitti" => Ok(Target::Kitti),
             "pcd" => Ok(Target::Pcd),
             "rosbag2" | "bag" | "mcap" => Ok(Target::Rosbag2),
-            other => Err(format!(
-                "{other:?}: expected carmen, kitti, pcd or rosbag2"
-            )),
+            other => Err(format!("{other:?}: expected carmen, kitti, pcd or rosbag2")),
         }
     }
 }
@@ -123,7 +121,10 @@ pub fn convert(input: &Path, output: &Path, options: &ConvertOptions) -> Result<
         (Input::Spatial(sweeps), Target::Kitti) => write_kitti(output, &sweeps)?,
         (Input::Spatial(sweeps), Target::Pcd) => write_pcds(output, &sweeps)?,
         (Input::Planar(_), t) => {
-            return Err(unsupported(input, format!("planar scans cannot be written as {t:?}")));
+            return Err(unsupported(
+                input,
+                format!("planar scans cannot be written as {t:?}"),
+            ));
         }
         (Input::Spatial(_), Target::Carmen) => {
             return Err(unsupported(
@@ -219,7 +220,11 @@ fn target_from_path(output: &Path, planar: bool) -> Result<Target> {
     } else if stem.ends_with(".log") || stem.ends_with(".clf") {
         Target::Carmen
     } else if output.extension().is_none() {
-        if planar { Target::Rosbag2 } else { Target::Kitti }
+        if planar {
+            Target::Rosbag2
+        } else {
+            Target::Kitti
+        }
     } else {
         return Err(unsupported(
             output,
@@ -240,11 +245,8 @@ fn default_fan(frame: &PlanarFrame) -> bool {
 
 fn write_carmen(path: &Path, frames: &[PlanarFrame]) -> Result<PathBuf> {
     let file = std::fs::File::create(path).map_err(|e| Error::io(path, Location::File, e))?;
-    let mut writer = CarmenWriter::with_format(
-        std::io::BufWriter::new(file),
-        path,
-        NumberFormat::exact(),
-    );
+    let mut writer =
+        CarmenWriter::with_format(std::io::BufWriter::new(file), path, NumberFormat::exact());
     writer.header()?;
     writer.comment("written by raypath convert")?;
     for frame in frames {

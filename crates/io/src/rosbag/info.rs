@@ -161,7 +161,7 @@ pub fn info(path: &Path) -> Result<BagInfo> {
 fn linear_info(file: &Path, index: u32) -> Result<FileInfo> {
     let mut reader = McapReader::open(file, index, Arc::new(|_| None))?;
     while reader.next_message()?.is_some() {}
-    let stats = reader.channel_stats().clone();
+    let stats = reader.channel_stats();
     let mut channels: Vec<(ChannelInfo, ChannelStats)> = reader
         .channels()
         .map(|c| (c.clone(), stats.get(&c.id).copied().unwrap_or_default()))

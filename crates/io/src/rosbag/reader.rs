@@ -1,6 +1,6 @@
 //! Streaming MCAP reading over a `File`: top-level records framed here (so every message has
-//! a place in the file to come back to), chunks decompressed with the `mcap` crate's sans-io
-//! reader, messages handed out one at a time from reused buffers.
+//! a place in the file to come back to), chunks decoded by [`ChunkBuf`] into reused buffers,
+//! messages handed out one at a time.
 
 use std::collections::{BTreeSet, HashMap};
 use std::fs::File;
@@ -10,8 +10,14 @@ use std::sync::Arc;
 
 use super::bag::MAGIC;
 pub use super::chunk::ChannelStats;
-use super::chunk::{Channels, decode_chunk};
+use super::chunk::{Channels, ChunkBuf, chunk_compression, message_head, record_head};
 use crate::error::{Error, Location, Result};
+
+mod prefetch;
+mod reread;
+
+use prefetch::Lookahead;
+pub use reread::ChunkCache;
 
 const OP_HEADER: u8 = 0x01;
 const OP_FOOTER: u8 = 0x02;
@@ -72,15 +78,9 @@ pub struct Message<'a> {
     pub loc: MessageLoc,
 }
 
-/// The decoded records of one chunk: `[opcode][u64 length][body]` each; skipped messages are
-/// kept as empty message records so that ordinals stay right.
-#[derive(Default)]
-struct ChunkBuf {
-    data: Vec<u8>,
-    pos: usize,
-    offset: u64,
-    next_index: u32,
-}
+/// Messages of a prefix-only role are handed out up to this many bytes (enough for their
+/// header).
+const PREFIX_BYTES: usize = MESSAGE_HEAD + 4096;
 
 /// Reads the messages of one MCAP file in file order.
 pub struct McapReader {
@@ -94,12 +94,16 @@ pub struct McapReader {
     in_chunk: bool,
     channels: Channels,
     profile: String,
-    last_log_time: HashMap<u16, u64>,
     order_warnings: usize,
     last_delivered: Option<(u16, u64)>,
     warnings: Vec<String>,
     truncated_chunk: Option<(u64, u64)>,
     done: bool,
+    /// Chunks decompressed ahead on other threads (started at the first compressed chunk).
+    lookahead: Option<Lookahead>,
+    lookahead_tried: bool,
+    /// The path, shared with the threads that read ahead.
+    shared_path: Option<Arc<Path>>,
 }
 
 enum Found {
@@ -118,28 +122,23 @@ impl McapReader {
         let mut reader = Self {
             path: path.to_path_buf(),
             file_index,
-            file: BufReader::with_capacity(1 << 16, file),
+            // Small: after a chunk decoded ahead is skipped, only a few index records are read.
+            file: BufReader::with_capacity(1 << 13, file),
             len,
             pos: 0,
             record: Vec::new(),
             chunk: ChunkBuf::default(),
             in_chunk: false,
-            channels: Channels {
-                schemas: HashMap::new(),
-                channels: HashMap::new(),
-                roles: HashMap::new(),
-                stats: HashMap::new(),
-                compressions: BTreeSet::new(),
-                prefix_role: None,
-                classify,
-            },
+            channels: Channels::new(classify),
             profile: String::new(),
-            last_log_time: HashMap::new(),
             order_warnings: 0,
             last_delivered: None,
             warnings: Vec::new(),
             truncated_chunk: None,
             done: false,
+            lookahead: None,
+            lookahead_tried: false,
+            shared_path: None,
         };
         let mut magic = [0u8; 8];
         if len < 8 || reader.file.read_exact(&mut magic).is_err() || &magic != MAGIC {
@@ -167,12 +166,12 @@ impl McapReader {
 
     /// The channels seen so far.
     pub fn channels(&self) -> impl Iterator<Item = &ChannelInfo> {
-        self.channels.channels.values()
+        self.channels.iter()
     }
 
     /// The channel `id`.
     pub fn channel(&self, id: u16) -> Option<&ChannelInfo> {
-        self.channels.channels.get(&id)
+        self.channels.get(id)
     }
 
     /// Keeps only the first few kilobytes (the header) of the messages of `role`.
@@ -181,8 +180,8 @@ impl McapReader {
     }
 
     /// Message counts and log-time spans per channel id so far (of every channel).
-    pub fn channel_stats(&self) -> &HashMap<u16, ChannelStats> {
-        &self.channels.stats
+    pub fn channel_stats(&self) -> HashMap<u16, ChannelStats> {
+        self.channels.stats()
     }
 
     /// The chunk compressions seen so far (`""` for uncompressed chunks).
@@ -264,28 +263,32 @@ impl McapReader {
         }
         let step = RECORD_HEAD as u64 + body_len;
         self.file
-            .seek(SeekFrom::Start(self.pos + step))
+            .seek_relative(step as i64)
             .map_err(|e| Error::io(&self.path, Location::Byte(self.pos), e))?;
         self.pos += step;
         Ok(true)
     }
 
-    /// Reads and decodes the chunk whose record starts at `pos`.
+    /// Reads the chunk whose record starts at `pos` and decodes it (lazily when only the
+    /// first bytes of some messages are wanted).
     fn load_chunk(&mut self, body_len: u64) -> Result<()> {
         let at = self.pos;
         let complete = self.read_record(body_len)?;
-        if let Err(reason) = decode_chunk(
-            &self.record,
-            complete,
-            &mut self.channels,
-            false,
-            &mut self.chunk.data,
-        ) {
+        if let Some(name) = chunk_compression(&self.record)
+            && !self
+                .channels
+                .compressions
+                .contains(&*String::from_utf8_lossy(name))
+        {
+            self.channels
+                .compressions
+                .insert(String::from_utf8_lossy(name).into_owned());
+        }
+        let lazy = complete && self.channels.prefix_role.is_some();
+        self.chunk.offset = at;
+        if let Err(reason) = self.chunk.load(&mut self.record, complete, lazy) {
             return Err(self.malformed(at, format!("chunk: {reason}")));
         }
-        self.chunk.pos = 0;
-        self.chunk.offset = at;
-        self.chunk.next_index = 0;
         self.in_chunk = true;
         if !complete {
             self.done = true;
@@ -294,42 +297,135 @@ impl McapReader {
         Ok(())
     }
 
+    /// Moves to the chunk at `pos`: decoded ahead, or now (and then, when it is compressed
+    /// and wanted whole, the chunks after it are decoded ahead from now on).
+    fn next_chunk(&mut self, body_len: u64) -> Result<()> {
+        let at = self.pos;
+        if let Some(ahead) = self.lookahead.as_mut()
+            && let Some(result) = ahead.take(at, &mut self.chunk)
+        {
+            if let Err(reason) = result {
+                return Err(self.malformed(at, format!("chunk: {reason}")));
+            }
+            let name = self.chunk.compression_name();
+            if !self.channels.compressions.contains(name) {
+                self.channels.compressions.insert(name.to_string());
+            }
+            self.chunk.offset = at;
+            self.in_chunk = true;
+            // The look-ahead found the whole record: it is in the file.
+            self.skip_record(body_len)?;
+            if let Some(ahead) = self.lookahead.as_mut() {
+                ahead.top_up();
+            }
+            return Ok(());
+        }
+        self.load_chunk(body_len)?;
+        let wanted_whole =
+            self.chunk.compressed() && self.chunk.complete() && self.channels.prefix_role.is_none();
+        if wanted_whole && !self.lookahead_tried {
+            self.lookahead_tried = true;
+            self.lookahead = Lookahead::open(&self.path, self.file_index, self.len);
+        }
+        if let Some(ahead) = self.lookahead.as_mut()
+            && wanted_whole
+        {
+            ahead.restart(self.pos);
+            ahead.top_up();
+        }
+        Ok(())
+    }
+
+    /// Decodes the current chunk up to byte `upto`; false when it does not go that far.
+    fn fill(&mut self, upto: usize) -> Result<bool> {
+        self.chunk
+            .fill(upto)
+            .map_err(|reason| self.malformed(self.chunk.offset, format!("chunk: {reason}")))
+    }
+
+    /// The next message with a role in the current chunk (registering schemas and channels
+    /// and counting messages on the way), or `None` at its end.
+    fn next_in_chunk(&mut self) -> Result<Option<Found>> {
+        loop {
+            let p = self.chunk.pos;
+            if p + RECORD_HEAD > self.chunk.end() || !self.fill(p + RECORD_HEAD)? {
+                return Ok(None);
+            }
+            let (opcode, len) = record_head(self.chunk.bytes(p, p + RECORD_HEAD), 0);
+            let start = p + RECORD_HEAD;
+            let stop = match usize::try_from(len).ok().and_then(|l| start.checked_add(l)) {
+                Some(stop) if stop <= self.chunk.end() => stop,
+                _ if self.chunk.complete() => {
+                    return Err(self.malformed(
+                        self.chunk.offset,
+                        format!("chunk: a record of {len} bytes overruns the chunk"),
+                    ));
+                }
+                _ => return Ok(None),
+            };
+            match opcode {
+                OP_MESSAGE => {
+                    let head_end = (start + MESSAGE_HEAD).min(stop);
+                    if !self.fill(head_end)? {
+                        return Ok(None);
+                    }
+                    let head = self.chunk.bytes(start, head_end);
+                    self.channels.count(head);
+                    let role = message_head(head).and_then(|(id, _)| self.channels.role(id));
+                    let index = self.chunk.next_index;
+                    self.chunk.next_index += 1;
+                    let Some(role) = role else {
+                        self.chunk.pos = stop;
+                        continue;
+                    };
+                    let keep = if Some(role) == self.channels.prefix_role {
+                        stop.min(start + PREFIX_BYTES)
+                    } else {
+                        stop
+                    };
+                    // A message cut short by the end of the file is not handed out, even when
+                    // only its first bytes are wanted.
+                    let need = if self.chunk.complete() { keep } else { stop };
+                    if !self.fill(need)? {
+                        return Ok(None);
+                    }
+                    self.chunk.pos = stop;
+                    return Ok(Some(Found::InChunk(start, keep, index)));
+                }
+                OP_SCHEMA | OP_CHANNEL => {
+                    if !self.fill(stop)? {
+                        return Ok(None);
+                    }
+                    if let Err(reason) = self
+                        .channels
+                        .register(opcode, self.chunk.bytes(start, stop))
+                    {
+                        return Err(self.malformed(self.chunk.offset, format!("chunk: {reason}")));
+                    }
+                    self.chunk.pos = stop;
+                }
+                _ => self.chunk.pos = stop,
+            }
+        }
+    }
+
     /// The next message of a channel with a role, or `None` at the end of the file (or of
     /// what could be read of it: see [`McapReader::warnings`]).
     pub fn next_message(&mut self) -> Result<Option<Message<'_>>> {
         let found = loop {
             if self.in_chunk {
-                let buf = &self.chunk.data;
-                let p = self.chunk.pos;
-                if p + RECORD_HEAD > buf.len() {
-                    self.in_chunk = false;
-                    if let Some((at, body_len)) = self.truncated_chunk.take() {
-                        let words = self.last_message_words();
-                        self.warnings.push(format!(
-                            "{}: byte {at}: the file is truncated inside a chunk of {body_len} \
-                             bytes: the messages before the cut were read, the rest of the \
-                             chunk is lost; {words}",
-                            self.path.display()
-                        ));
-                    }
-                    continue;
+                if let Some(found) = self.next_in_chunk()? {
+                    break found;
                 }
-                let len = u64::from_le_bytes([
-                    buf[p + 1],
-                    buf[p + 2],
-                    buf[p + 3],
-                    buf[p + 4],
-                    buf[p + 5],
-                    buf[p + 6],
-                    buf[p + 7],
-                    buf[p + 8],
-                ]) as usize;
-                let start = p + RECORD_HEAD;
-                self.chunk.pos = start + len;
-                let index = self.chunk.next_index;
-                self.chunk.next_index += 1;
-                if len > 0 {
-                    break Found::InChunk(start, start + len, index);
+                self.in_chunk = false;
+                if let Some((at, body_len)) = self.truncated_chunk.take() {
+                    let words = self.last_message_words();
+                    self.warnings.push(format!(
+                        "{}: byte {at}: the file is truncated inside a chunk of {body_len} \
+                         bytes: the messages before the cut were read, the rest of the \
+                         chunk is lost; {words}",
+                        self.path.display()
+                    ));
                 }
                 continue;
             }
@@ -341,7 +437,7 @@ impl McapReader {
                 return Ok(None);
             };
             match opcode {
-                OP_CHUNK => self.load_chunk(body_len)?,
+                OP_CHUNK => self.next_chunk(body_len)?,
                 OP_MESSAGE | OP_SCHEMA | OP_CHANNEL => {
                     let at = self.pos;
                     if !self.read_record(body_len)? {
@@ -364,8 +460,8 @@ impl McapReader {
                     if body.len() >= MESSAGE_HEAD
                         && self
                             .channels
-                            .roles
-                            .contains_key(&u16::from_le_bytes([body[0], body[1]]))
+                            .role(u16::from_le_bytes([body[0], body[1]]))
+                            .is_some()
                     {
                         self.chunk.offset = at;
                         break Found::Record;
@@ -390,7 +486,7 @@ impl McapReader {
         };
         let (body, loc) = match found {
             Found::InChunk(start, end, index) => (
-                &self.chunk.data[start..end],
+                self.chunk.bytes(start, end),
                 MessageLoc {
                     file: self.file_index,
                     record_offset: self.chunk.offset,
@@ -410,17 +506,13 @@ impl McapReader {
         let log_time = u64::from_le_bytes([
             body[6], body[7], body[8], body[9], body[10], body[11], body[12], body[13],
         ]);
-        let role = self.channels.roles.get(&channel_id).copied().unwrap_or(0);
-        if let Some(prev) = self.last_log_time.insert(channel_id, log_time)
+        let role = self.channels.role(channel_id).unwrap_or(0);
+        if let Some(prev) = self.channels.handed_out(channel_id, log_time)
             && log_time < prev
         {
             self.order_warnings += 1;
             if self.order_warnings <= MAX_ORDER_WARNINGS {
-                let topic = self
-                    .channels
-                    .channels
-                    .get(&channel_id)
-                    .map_or("?", |c| c.topic.as_str());
+                let topic = self.channel(channel_id).map_or("?", |c| c.topic.as_str());
                 self.warnings.push(format!(
                     "{}: {topic}: log time {:.9} s comes after {:.9} s (messages out of order)",
                     self.path.display(),
@@ -430,11 +522,7 @@ impl McapReader {
             }
         }
         self.last_delivered = Some((channel_id, log_time));
-        let topic = self
-            .channels
-            .channels
-            .get(&channel_id)
-            .map_or("", |c| c.topic.as_str());
+        let topic = self.channel(channel_id).map_or("", |c| c.topic.as_str());
         Ok(Some(Message {
             role,
             topic,
@@ -449,72 +537,14 @@ impl McapReader {
         self.order_warnings.saturating_sub(MAX_ORDER_WARNINGS)
     }
 
-    /// Reads the message at `loc` again (the file's channels must have been read up to it:
-    /// they are, after a pass over the file). The chunk is decoded into `cache` unless it is
-    /// there already; returns the message body range in `cache.data` or in `self.record`.
-    pub fn reread<'a>(
-        &'a mut self,
-        loc: MessageLoc,
-        cache: &'a mut ChunkCache,
-    ) -> Result<&'a [u8]> {
-        let at = loc.record_offset;
-        let missing = || "the message is no longer where the first pass found it".to_string();
-        if at + RECORD_HEAD as u64 > self.len {
-            return Err(self.malformed(at, missing()));
-        }
+    fn seek_to(&mut self, at: u64) -> Result<()> {
         self.file
             .seek(SeekFrom::Start(at))
             .map_err(|e| Error::io(&self.path, Location::Byte(at), e))?;
         self.pos = at;
-        if loc.index == u32::MAX {
-            let Some((OP_MESSAGE, body_len)) = self.peek_head()? else {
-                return Err(self.malformed(at, missing()));
-            };
-            if !self.read_record(body_len)? || self.record.len() < RECORD_HEAD + MESSAGE_HEAD {
-                return Err(self.malformed(at, missing()));
-            }
-            return Ok(&self.record[RECORD_HEAD + MESSAGE_HEAD..]);
-        }
-        if cache.key != Some((loc.file, at)) {
-            cache.key = None;
-            let Some((OP_CHUNK, body_len)) = self.peek_head()? else {
-                return Err(self.malformed(at, missing()));
-            };
-            let complete = self.read_record(body_len)?;
-            decode_chunk(
-                &self.record,
-                complete,
-                &mut self.channels,
-                true,
-                &mut cache.data,
-            )
-            .map_err(|reason| self.malformed(at, format!("chunk: {reason}")))?;
-            cache.starts.clear();
-            let mut p = 0;
-            while p + RECORD_HEAD <= cache.data.len() {
-                let len = u64::from_le_bytes(
-                    cache.data[p + 1..p + RECORD_HEAD]
-                        .try_into()
-                        .unwrap_or_default(),
-                ) as usize;
-                cache.starts.push((p + RECORD_HEAD, len));
-                p += RECORD_HEAD + len;
-            }
-            cache.key = Some((loc.file, at));
-        }
-        match cache.starts.get(loc.index as usize) {
-            Some(&(start, len)) if len >= MESSAGE_HEAD => {
-                Ok(&cache.data[start + MESSAGE_HEAD..start + len])
-            }
-            _ => Err(self.malformed(at, missing())),
-        }
+        Ok(())
     }
 }
 
-/// The last chunk decoded for random access.
-#[derive(Default)]
-pub struct ChunkCache {
-    key: Option<(u32, u64)>,
-    data: Vec<u8>,
-    starts: Vec<(usize, usize)>,
-}
+#[cfg(test)]
+mod tests;

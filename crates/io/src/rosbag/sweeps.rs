@@ -20,7 +20,14 @@ struct Rereader {
     files: Vec<PathBuf>,
     topic: String,
     refs: Vec<CloudRef>,
-    state: Mutex<(Vec<Option<McapReader>>, ChunkCache)>,
+    state: Mutex<State>,
+}
+
+/// The open files, the last chunk decoded (and those decoded ahead), the last sweep read.
+struct State {
+    readers: Vec<Option<McapReader>>,
+    cache: ChunkCache,
+    last: Option<usize>,
 }
 
 impl Rereader {
@@ -41,18 +48,34 @@ impl Rereader {
                 path: file.clone(),
                 reason: "an earlier read panicked".into(),
             })?;
-            let (readers, cache) = &mut *guard;
-            let slot = &mut readers[r.loc.file as usize];
+            let state = &mut *guard;
+            // Read in order: the next clouds' chunks are decoded ahead meanwhile.
+            let in_order = state.last.is_none_or(|last| index == last + 1);
+            state.last = Some(index);
+            let slot = &mut state.readers[r.loc.file as usize];
             if slot.is_none() {
                 let classify: Classify = Arc::new(|_| None);
                 *slot = Some(McapReader::open(file, r.loc.file, classify)?);
             }
             match slot.as_mut() {
-                Some(reader) => reader.reread(r.loc, cache)?.to_vec(),
-                None => Vec::new(),
+                Some(reader) => {
+                    let data = reader.reread(r.loc, &mut state.cache)?;
+                    if in_order {
+                        let next = self.refs[index + 1..].iter().map(|r| r.loc);
+                        reader.prefetch(next, &mut state.cache);
+                    }
+                    data
+                }
+                None => {
+                    return Err(Error::UnknownFormat {
+                        path: file.clone(),
+                        reason: "the file cannot be opened again".into(),
+                    });
+                }
             }
         };
-        let (_, cloud) = decode_cloud(&data)
+        // Decoded without the lock (and without copying the message out of its chunk).
+        let (_, cloud) = decode_cloud(data.bytes())
             .map_err(|e| message_error(file, r.loc, &self.topic, r.log_time, e))?;
         Ok(cloud)
     }
@@ -132,10 +155,11 @@ pub fn open_sweeps(path: &Path, topics: &Topics) -> Result<SweepSequence> {
     }
     let reference: Option<Vec<Pose3>> = reference.into_iter().collect();
     let reader = Rereader {
-        state: Mutex::new((
-            (0..bag.files.len()).map(|_| None).collect(),
-            ChunkCache::default(),
-        )),
+        state: Mutex::new(State {
+            readers: (0..bag.files.len()).map(|_| None).collect(),
+            cache: ChunkCache::default(),
+            last: None,
+        }),
         files: bag.files,
         topic,
         refs: kept,

@@ -428,4 +428,3 @@ pub fn write_sweeps(
     }
     w.finish()
 }
-
