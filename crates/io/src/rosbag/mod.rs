@@ -4,7 +4,8 @@
 //! A bag is given as its directory (with `metadata.yaml`, whose `relative_file_paths` name
 //! the `.mcap` files and whose `storage_identifier` must be `mcap`) or as one `.mcap` file.
 //! Files are streamed from disk (no memory map, never read whole): zstd and LZ4 chunks are
-//! decompressed one at a time, indexed and unindexed files are read by a linear scan, and a
+//! decompressed into reused buffers, several ahead on worker threads (one per core, at most
+//! 4; LZ4 frames are decoded here), indexed and unindexed files are read by a linear scan, and a
 //! file cut short (a recording that was not closed) gives a warning naming the place and the
 //! last topic and log time read, after the messages before the cut. The header profile must
 //! be `ros2` with CDR messages; a ROS 1 recording gives "not a ROS 2 bag", a bag without a
@@ -55,8 +56,10 @@
 //!   naming file, topic and log time.
 //!
 //! Odometry, tf and reference poses are read in a first pass (they are small); scans are
-//! streamed in a second pass, clouds are read again on demand ([`SweepSequence::sweep`])
-//! with the last decompressed chunk cached.
+//! streamed in a second pass and decoded on worker threads; clouds are read again on demand
+//! ([`SweepSequence::sweep`]), the next ones decoded ahead. The first pass of
+//! [`open_sweeps`] decompresses only the start of a chunk that ends with a cloud, so that
+//! chunk's CRC is checked when the cloud is read.
 //!
 //! # Writing
 //!

@@ -1,5 +1,7 @@
 //! Planar frames from the `LaserScan` topic of a bag.
 
+mod decode;
+
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -7,18 +9,19 @@ use std::sync::Arc;
 use raypath_geometry::Pose3;
 
 use super::bag::BagFiles;
-use super::msgs;
 use super::poses::Poses;
 use super::reader::{ChannelInfo, Classify, McapReader};
 use super::select::{LASER_SCAN, ROLE_SCAN, first_pass, is_ros2, message_error, normalize_type};
 use crate::error::{Error, Result};
 use crate::sequence::{Origin, PlanarFrame, PlanarSource, Topics};
+use decode::{BATCH, Batch, Decoders};
 
 /// Skipped scans are listed one by one up to this many.
 const MAX_SKIP_WARNINGS: usize = 5;
 
 /// The scans of one `sensor_msgs/msg/LaserScan` topic of a bag with their poses, streamed in
-/// file order (a second pass after odometry and tf were read).
+/// file order (a second pass after odometry and tf were read; the scans are decoded ahead on
+/// other threads while the poses of earlier ones are computed).
 pub struct BagScans {
     name: PathBuf,
     files: Vec<PathBuf>,
@@ -30,6 +33,13 @@ pub struct BagScans {
     warnings: Vec<String>,
     skipped: usize,
     failed: bool,
+    decoders: Decoders,
+    /// The batch whose frames are being handed out, and the next of them.
+    current: Option<(Batch, usize)>,
+    /// An error met while reading ahead: handed out after the scans before it.
+    deferred: Option<Error>,
+    /// Every file was read.
+    exhausted: bool,
 }
 
 /// Reads the odometry, tf and reference poses of the bag at `path` and streams the scans of
@@ -76,6 +86,10 @@ impl BagScans {
             warnings: pass.warnings,
             skipped: 0,
             failed: false,
+            decoders: Decoders::start(),
+            current: None,
+            deferred: None,
+            exhausted: false,
         })
     }
 
@@ -119,33 +133,84 @@ impl BagScans {
         Ok(true)
     }
 
+    /// Reads scans ahead (raw) into batches for the decoders, until enough are ahead or the
+    /// files end; an error is kept for after the scans before it.
+    fn read_ahead(&mut self) {
+        while self.deferred.is_none() && !self.exhausted && self.decoders.has_room() {
+            let mut batch = self.decoders.batch();
+            while batch.items.len() < BATCH {
+                if self.reader.is_none() {
+                    match self.open_next() {
+                        Ok(true) => {}
+                        Ok(false) => {
+                            self.exhausted = true;
+                            break;
+                        }
+                        Err(e) => {
+                            self.deferred = Some(e);
+                            break;
+                        }
+                    }
+                }
+                let Some(reader) = self.reader.as_mut() else {
+                    break;
+                };
+                match reader.next_message() {
+                    Ok(Some(m)) => batch.push(self.next_file - 1, m.log_time, m.loc, m.data),
+                    Ok(None) => {
+                        self.flush_warnings();
+                        self.reader = None;
+                    }
+                    Err(e) => {
+                        self.deferred = Some(e);
+                        break;
+                    }
+                }
+            }
+            if batch.items.is_empty() {
+                self.decoders.recycle(batch);
+                break;
+            }
+            self.decoders.submit(batch);
+        }
+    }
+
     fn next_frame(&mut self) -> Result<Option<PlanarFrame>> {
         loop {
-            if self.reader.is_none() && !self.open_next()? {
-                if self.skipped > MAX_SKIP_WARNINGS {
-                    eprintln!(
-                        "warning: {}: {} scans of {} skipped in all (odometry or tf do not \
-                         cover their times)",
-                        self.name.display(),
-                        self.skipped,
-                        self.topic
-                    );
+            let Some((batch, next)) = self.current.as_mut() else {
+                self.read_ahead();
+                let batch = self
+                    .decoders
+                    .next()
+                    .map_err(|reason| Error::UnknownFormat {
+                        path: self.name.clone(),
+                        reason,
+                    })?;
+                match batch {
+                    Some(batch) => self.current = Some((batch, 0)),
+                    None => return self.end(),
                 }
-                return Ok(None);
-            }
-            let Some(reader) = self.reader.as_mut() else {
                 continue;
             };
-            let Some(m) = reader.next_message()? else {
-                self.flush_warnings();
-                self.reader = None;
+            let Some(item) = batch.items.get_mut(*next) else {
+                if let Some((batch, _)) = self.current.take() {
+                    self.decoders.recycle(batch);
+                }
                 continue;
             };
-            let file = &self.files[self.next_file - 1];
-            let (header, scan) = msgs::decode_scan(m.data)
-                .map_err(|e| message_error(file, m.loc, &self.topic, m.log_time, e))?;
-            let t = header.stamp.secs();
-            let poses = match self.poses.at(header.frame_id, t) {
+            *next += 1;
+            let (log_time, loc, file) = (item.log_time, item.loc, item.file);
+            let file = &self.files[file];
+            let decoded = item.decoded.take().unwrap_or_else(|| {
+                Err(super::cdr::CdrError {
+                    offset: 0,
+                    reason: "not decoded".into(),
+                })
+            });
+            let (stamp, frame, scan) =
+                decoded.map_err(|e| message_error(file, loc, &self.topic, log_time, e))?;
+            let t = stamp.secs();
+            let poses = match self.poses.at(batch.frame(&frame), t) {
                 Ok(p) => p,
                 Err(reason) => {
                     self.skipped += 1;
@@ -154,7 +219,7 @@ impl BagScans {
                             "{}: {} at log time {:.9} s skipped: {reason}",
                             file.display(),
                             self.topic,
-                            m.log_time as f64 * 1e-9
+                            log_time as f64 * 1e-9
                         );
                         eprintln!("warning: {w}");
                         self.warnings.push(w);
@@ -169,9 +234,26 @@ impl BagScans {
                 world_from_robot: world_from_robot.to_planar(),
                 world_from_laser: (world_from_robot * poses.robot_from_sensor).to_planar(),
                 reference: poses.reference.map(|p| p.to_planar()),
-                origin: Origin::LogTimeNs(m.log_time),
+                origin: Origin::LogTimeNs(log_time),
             }));
         }
+    }
+
+    /// After the last scan: the error met reading ahead, if any, else the end.
+    fn end(&mut self) -> Result<Option<PlanarFrame>> {
+        if let Some(e) = self.deferred.take() {
+            return Err(e);
+        }
+        if self.skipped > MAX_SKIP_WARNINGS {
+            eprintln!(
+                "warning: {}: {} scans of {} skipped in all (odometry or tf do not cover \
+                 their times)",
+                self.name.display(),
+                self.skipped,
+                self.topic
+            );
+        }
+        Ok(None)
     }
 }
 
