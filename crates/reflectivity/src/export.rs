@@ -18,8 +18,9 @@ use raypath_geometry::Pose2;
 use crate::error::{ReflectivityError, Result};
 use crate::grid::{GridLevel, probability};
 
-/// The index box `[i0, i1) × [j0, j1)` of observed cells plus `margin` cells.
-fn observed_box(level: &GridLevel, margin: usize) -> Option<[usize; 4]> {
+/// The index box `[i0, j0, i1, j1)` (half-open) of the observed cells (non-zero log-odds)
+/// plus `margin` cells, clipped to the grid; `None` when no cell is observed.
+pub fn observed_box(level: &GridLevel, margin: usize) -> Option<[usize; 4]> {
     let (mut i0, mut j0, mut i1, mut j1) = (usize::MAX, usize::MAX, 0, 0);
     for j in 0..level.height() {
         for i in 0..level.width() {

@@ -39,7 +39,7 @@ pub fn record(
     let Some(level) = level else {
         return Ok(());
     };
-    let Some([i0, j0, i1, j1]) = observed_box(level) else {
+    let Some([i0, j0, i1, j1]) = raypath_reflectivity::export::observed_box(level, MARGIN) else {
         return Ok(());
     };
     let cells = || (j0..j1).flat_map(|j| (i0..i1).map(move |i| (i, j)));
@@ -70,27 +70,4 @@ pub fn record(
         recording.grid_layer(topic::REFLECTIVITY, end, &layer)?;
     }
     Ok(())
-}
-
-/// The index box `[i0, j0, i1, j1)` of the cells with non-zero log-odds plus [`MARGIN`].
-fn observed_box(level: &GridLevel) -> Option<[usize; 4]> {
-    let (mut i0, mut j0, mut i1, mut j1) = (usize::MAX, usize::MAX, 0, 0);
-    for j in 0..level.height() {
-        for i in 0..level.width() {
-            if level.log_odds(i, j) != 0.0 {
-                i0 = i0.min(i);
-                j0 = j0.min(j);
-                i1 = i1.max(i + 1);
-                j1 = j1.max(j + 1);
-            }
-        }
-    }
-    (i1 > 0).then(|| {
-        [
-            i0.saturating_sub(MARGIN),
-            j0.saturating_sub(MARGIN),
-            (i1 + MARGIN).min(level.width()),
-            (j1 + MARGIN).min(level.height()),
-        ]
-    })
 }
