@@ -268,27 +268,9 @@ fn planes_records_the_labelled_cloud_and_the_plane_outlines() {
     }
 }
 
-/// Whether `python3` can import `mcap`; panics instead of skipping when CI requires Python.
-fn python_with_mcap() -> bool {
-    let probe = Command::new("python3").args(["-c", "import mcap"]).output();
-    let reason = match probe {
-        Ok(out) if out.status.success() => return true,
-        Ok(out) => format!(
-            "python3 cannot import mcap: {}",
-            String::from_utf8_lossy(&out.stderr).trim()
-        ),
-        Err(e) => format!("python3 not runnable: {e}"),
-    };
-    if std::env::var("RAYPATH_REQUIRE_PYTHON").is_ok_and(|v| v == "1") {
-        panic!("RAYPATH_REQUIRE_PYTHON=1 but {reason}");
-    }
-    eprintln!("skipping: {reason} (pip install mcap)");
-    false
-}
-
 #[test]
 fn a_poles_map_recording_opens_in_the_python_mcap_reader() {
-    if !python_with_mcap() {
+    if !raypath_io::data::require_python("mcap") {
         return;
     }
     let dir = tempfile::tempdir().unwrap();

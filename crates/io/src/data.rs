@@ -47,3 +47,26 @@ pub fn require(relative: impl AsRef<Path>) -> Option<PathBuf> {
     }
     found
 }
+
+/// For tests that check our files with Python tools: true when `python3` imports every module
+/// of `imports` (for example `"rosbags, mcap"`). Otherwise prints a "skipping" message naming
+/// the reason and returns false, or, when the environment sets `RAYPATH_REQUIRE_PYTHON=1` (CI
+/// does), panics so the missing tool cannot pass unseen.
+pub fn require_python(imports: &str) -> bool {
+    let probe = std::process::Command::new("python3")
+        .args(["-c", &format!("import {imports}")])
+        .output();
+    let reason = match probe {
+        Ok(out) if out.status.success() => return true,
+        Ok(out) => format!(
+            "python3 cannot import {imports}: {}",
+            String::from_utf8_lossy(&out.stderr).trim()
+        ),
+        Err(e) => format!("python3 not runnable: {e}"),
+    };
+    if std::env::var("RAYPATH_REQUIRE_PYTHON").is_ok_and(|v| v == "1") {
+        panic!("RAYPATH_REQUIRE_PYTHON=1 but {reason}");
+    }
+    eprintln!("skipping: {reason}");
+    false
+}

@@ -19,24 +19,6 @@ use raypath_io::foxglove::{
 };
 use serde_json::{Value, json};
 
-/// Whether `python3` can import `mcap`; panics instead of skipping when CI requires Python.
-fn python_with_mcap() -> bool {
-    let probe = Command::new("python3").args(["-c", "import mcap"]).output();
-    let reason = match probe {
-        Ok(out) if out.status.success() => return true,
-        Ok(out) => format!(
-            "python3 cannot import mcap: {}",
-            String::from_utf8_lossy(&out.stderr).trim()
-        ),
-        Err(e) => format!("python3 not runnable: {e}"),
-    };
-    if std::env::var("RAYPATH_REQUIRE_PYTHON").is_ok_and(|v| v == "1") {
-        panic!("RAYPATH_REQUIRE_PYTHON=1 but {reason}");
-    }
-    eprintln!("skipping: {reason} (pip install mcap)");
-    false
-}
-
 /// `(topic, index, path, value)` checks for the Python side.
 struct Expect(Vec<Value>);
 
@@ -340,7 +322,7 @@ fn check(edit: impl FnOnce(&mut Value)) -> (bool, String, String, Value) {
 
 #[test]
 fn python_mcap_reads_every_message_kind() {
-    if !python_with_mcap() {
+    if !raypath_io::data::require_python("mcap") {
         return;
     }
     let (ok, stdout, stderr, expectations) = check(|_| {});
@@ -359,7 +341,7 @@ fn python_mcap_reads_every_message_kind() {
 
 #[test]
 fn python_checker_reports_wrong_counts_and_values() {
-    if !python_with_mcap() {
+    if !raypath_io::data::require_python("mcap") {
         return;
     }
     let (ok, _, stderr, _) = check(|e| {

@@ -23,24 +23,6 @@ fn fixture(name: &str) -> String {
     format!("{}/tests/fixtures/{name}", env!("CARGO_MANIFEST_DIR"))
 }
 
-fn python_ready() -> bool {
-    let ok = Command::new("python3")
-        .args(["-c", "import rosbags, mcap, mcap_ros2, numpy"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        if std::env::var("RAYPATH_REQUIRE_PYTHON").is_ok_and(|v| v == "1") {
-            panic!(
-                "RAYPATH_REQUIRE_PYTHON=1 but python3 with rosbags, mcap, mcap-ros2-support and numpy is missing"
-            );
-        }
-        eprintln!(
-            "skipping: python3 with rosbags, mcap, mcap-ros2-support and numpy is not available"
-        );
-    }
-    ok
-}
-
 fn python(args: &[&str]) -> String {
     let out = Command::new("python3").args(args).output().unwrap();
     assert!(
@@ -56,7 +38,7 @@ fn rosbags_carmen_bags_equal_the_log() {
     let Some(log) = raypath_io::data::require("carmen/corrected/intel-corrected.log.gz") else {
         return;
     };
-    if !python_ready() {
+    if !raypath_io::data::require_python("rosbags, mcap, mcap_ros2, numpy") {
         return;
     }
     let frames = read_planar(&log, &PlanarOptions::default()).unwrap();
@@ -115,7 +97,7 @@ fn rosbags_kitti_bags_equal_the_sequence() {
     let Some(seq_dir) = raypath_io::data::require("kitti/sequences/00") else {
         return;
     };
-    if !python_ready() {
+    if !raypath_io::data::require_python("rosbags, mcap, mcap_ros2, numpy") {
         return;
     }
     let seq = SweepSequence::open(&seq_dir, &SweepOptions::default()).unwrap();
@@ -182,7 +164,7 @@ fn f(v: &Value) -> f64 {
 
 #[test]
 fn python_mcap_reads_our_bags() {
-    if !python_ready() {
+    if !raypath_io::data::require_python("rosbags, mcap, mcap_ros2, numpy") {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
