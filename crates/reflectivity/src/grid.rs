@@ -194,6 +194,40 @@ impl GridLevel {
         Some(self.bilinear(v, u, w))
     }
 
+    /// The part `[i0, i1) × [j0, j1)` of this level as a level of its own (same resolution,
+    /// the same map-frame positions; stamps reset), e.g. a finished submap cut to its observed
+    /// box ([`crate::export::observed_box`]). The bounds are clamped to the grid and keep at
+    /// least 2 × 2 cells where the grid has them.
+    pub fn crop(&self, bounds: [usize; 4]) -> GridLevel {
+        let i1 = bounds[2].min(self.width);
+        let j1 = bounds[3].min(self.height);
+        let i0 = bounds[0].min(i1.saturating_sub(2));
+        let j0 = bounds[1].min(j1.saturating_sub(2));
+        let (w, h) = (i1 - i0, j1 - j0);
+        let origin = [
+            self.origin[0] + i0 as f64 * self.resolution_m,
+            self.origin[1] + j0 as f64 * self.resolution_m,
+        ];
+        let mut out = GridLevel::new(self.resolution_m, origin, w, h);
+        let rows = |v: &[f32]| -> Vec<f32> {
+            (j0..j1)
+                .flat_map(|j| v[j * self.width + i0..j * self.width + i1].iter().copied())
+                .collect()
+        };
+        out.log_odds = rows(&self.log_odds);
+        if self.has_reflectivity() {
+            out.refl_mean = rows(&self.refl_mean);
+            out.refl_count = (j0..j1)
+                .flat_map(|j| {
+                    self.refl_count[j * self.width + i0..j * self.width + i1]
+                        .iter()
+                        .copied()
+                })
+                .collect();
+        }
+        out
+    }
+
     /// Starts a scan update: returns the stamp base for [`Self::mark_occupied`] and
     /// [`Self::mark_free`] (`scan_number` counts map updates from 0).
     pub(crate) fn stamp_base(scan_number: u32) -> u32 {

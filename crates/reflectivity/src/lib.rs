@@ -91,6 +91,6 @@ pub use error::{ReflectivityError, Result};
 pub use grid::{GridLevel, LOG_ODDS_LIMIT, Sample, logit, probability};
 pub use lut::{CalibrationSample, IntensityLut, LutConfig, ScatteredLinear};
 pub use map::{MapConfig, MultiResMap};
-pub use matcher::{MatchResult, MatcherConfig, Prior, ResidualMode, ScanMatcher};
+pub use matcher::{MatchResult, MatcherConfig, Prior, ResidualMode, ScanMatcher, match_levels};
 pub use points::{PointFilter, ScanPoints};
 pub use range_model::RangePolynomial;

@@ -105,6 +105,33 @@ impl MultiResMap {
         &self.levels
     }
 
+    /// The levels cut to the observed part of the finest level plus `margin` finest cells
+    /// ([`crate::export::observed_box`], [`GridLevel::crop`]): a compact frozen copy of a
+    /// finished submap that [`crate::match_levels`] can still match against. `None` when
+    /// nothing was observed.
+    pub fn cropped_levels(&self, margin: usize) -> Option<Vec<GridLevel>> {
+        let finest = self.levels.first()?;
+        let b = crate::export::observed_box(finest, margin)?;
+        let (res, o) = (finest.resolution_m(), finest.origin());
+        let lo = [o[0] + b[0] as f64 * res, o[1] + b[1] as f64 * res];
+        let hi = [o[0] + b[2] as f64 * res, o[1] + b[3] as f64 * res];
+        Some(
+            self.levels
+                .iter()
+                .map(|level| {
+                    let (r, lo_l) = (level.resolution_m(), level.origin());
+                    let cell = |v: f64, o: f64| ((v - o) / r).floor().max(0.0) as usize;
+                    level.crop([
+                        cell(lo[0], lo_l[0]),
+                        cell(lo[1], lo_l[1]),
+                        cell(hi[0], lo_l[0]) + 2,
+                        cell(hi[1], lo_l[1]) + 2,
+                    ])
+                })
+                .collect(),
+        )
+    }
+
     /// Number of map updates so far.
     pub fn updates(&self) -> u32 {
         self.updates

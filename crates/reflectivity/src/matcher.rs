@@ -19,6 +19,7 @@ use raypath_geometry::wrap_angle;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{ReflectivityError, Result, require_positive};
+use crate::grid::GridLevel;
 use crate::map::{MapConfig, MultiResMap};
 use crate::points::ScanPoints;
 
@@ -242,93 +243,108 @@ impl ScanMatcher {
         initial: Pose2,
         prior: Option<&Prior>,
     ) -> (Pose2, Matrix3<f64>) {
-        let mut zeta = Vector3::new(initial.x(), initial.y(), initial.theta());
-        let levels = self.map.levels().len();
-        for level in (0..levels).rev() {
-            let iterations = if level == 0 {
-                self.config.iterations_finest
-            } else {
-                self.config.iterations_coarse
-            };
-            for _ in 0..iterations {
-                let (h, g) = self.normal_equations(level, scan, &zeta, prior);
-                let Some(inv) = h.try_inverse() else {
-                    break;
-                };
-                let mut step = inv * g;
-                if !step.iter().all(|v| v.is_finite()) {
-                    break;
-                }
-                let m = self.config.max_rotation_step_rad;
-                step[2] = step[2].clamp(-m, m);
-                zeta += step; // Eq. (3.9): ζ ← ζ + H⁻¹ Σ Jᵀ r
-                zeta[2] = wrap_angle(zeta[2]);
-            }
-        }
-        let (h, _) = self.normal_equations(0, scan, &zeta, prior);
-        let sigma2 = self.config.covariance_sigma * self.config.covariance_sigma;
-        let covariance = h
-            .try_inverse()
-            .map_or(Matrix3::from_diagonal_element(f64::INFINITY), |inv| {
-                inv * sigma2
-            }); // K = σ² H⁻¹
-        (Pose2::new(zeta[0], zeta[1], zeta[2]), covariance)
+        match_levels(self.map.levels(), &self.config, scan, initial, prior)
     }
+}
 
-    /// `H = Σ JᵢᵀJᵢ` and `g = Σ Jᵢᵀ rᵢ` on one level at pose `zeta`.
-    fn normal_equations(
-        &self,
-        level: usize,
-        scan: &ScanPoints,
-        zeta: &Vector3<f64>,
-        prior: Option<&Prior>,
-    ) -> (Matrix3<f64>, Vector3<f64>) {
-        let mut h = Matrix3::zeros();
-        let mut g = Vector3::zeros();
-        let Some(grid) = self.map.levels().get(level) else {
-            return (h, g);
+/// Matches `scan` (sensor frame) against the grid `levels` (finest first, as
+/// [`MultiResMap::levels`]) from `initial`, coarse to fine, with the iterations, residual and
+/// step limit of `config` (its map settings are not used): returns the pose in the levels'
+/// frame and `σ² H⁻¹`. This is [`ScanMatcher::match_scan`] for maps the matcher does not own
+/// (submaps, cropped frozen grids).
+pub fn match_levels(
+    levels: &[GridLevel],
+    config: &MatcherConfig,
+    scan: &ScanPoints,
+    initial: Pose2,
+    prior: Option<&Prior>,
+) -> (Pose2, Matrix3<f64>) {
+    let mut zeta = Vector3::new(initial.x(), initial.y(), initial.theta());
+    for level in (0..levels.len()).rev() {
+        let iterations = if level == 0 {
+            config.iterations_finest
+        } else {
+            config.iterations_coarse
         };
-        let mode = self.config.mode;
-        let weight = self.config.reflectivity_weight;
-        let unobserved = self.config.unobserved_reflectivity;
-        let (c, s) = (zeta[2].cos(), zeta[2].sin());
-        let mut add = |grad: [f64; 2], ds_dtheta: [f64; 2], residual: f64, w: f64| {
-            // J_i = ∇M(S_i) ∂S_i/∂ζ  (eq. 3.9)
-            let j = Vector3::new(
-                grad[0],
-                grad[1],
-                grad[0] * ds_dtheta[0] + grad[1] * ds_dtheta[1],
-            );
-            h += j * j.transpose() * w; // H = Σ JᵢᵀJᵢ (spec FLAG: summed)
-            g += j * (residual * w);
-        };
-        for (p, &refl) in scan.points().iter().zip(scan.reflectivity()) {
-            // Eq. (3.7): S_i(ζ) = R(θ) s_i + t
-            let x = c * p[0] - s * p[1] + zeta[0];
-            let y = s * p[0] + c * p[1] + zeta[1];
-            // ∂S_i/∂θ = (−sinθ s_x − cosθ s_y, cosθ s_x − sinθ s_y)
-            let ds = [-s * p[0] - c * p[1], c * p[0] - s * p[1]];
-            if mode.occupancy() {
-                if let Some(m) = grid.occupancy(x, y) {
-                    add(m.gradient, ds, 1.0 - m.value, 1.0);
-                }
+        for _ in 0..iterations {
+            let (h, g) = normal_equations(&levels[level], config, scan, &zeta, prior);
+            let Some(inv) = h.try_inverse() else {
+                break;
+            };
+            let mut step = inv * g;
+            if !step.iter().all(|v| v.is_finite()) {
+                break;
             }
-            if mode.reflectivity() && refl.is_finite() {
-                if let Some(r) = grid.reflectivity(x, y, unobserved) {
-                    let w = if mode.occupancy() { weight } else { 1.0 };
-                    add(r.gradient, ds, refl - r.value, w); // Eq. (3.6) residual ϱ̄ − R(S_i)
-                }
-            }
+            let m = config.max_rotation_step_rad;
+            step[2] = step[2].clamp(-m, m);
+            zeta += step; // Eq. (3.9): ζ ← ζ + H⁻¹ Σ Jᵀ r
+            zeta[2] = wrap_angle(zeta[2]);
         }
-        if let Some(prior) = prior {
-            let d = Vector3::new(
-                prior.pose.x() - zeta[0],
-                prior.pose.y() - zeta[1],
-                wrap_angle(prior.pose.theta() - zeta[2]),
-            );
-            h += prior.information;
-            g += prior.information * d;
-        }
-        (h, g)
     }
+    let covariance = match levels.first() {
+        Some(finest) => {
+            let (h, _) = normal_equations(finest, config, scan, &zeta, prior);
+            let sigma2 = config.covariance_sigma * config.covariance_sigma;
+            h.try_inverse()
+                .map_or(Matrix3::from_diagonal_element(f64::INFINITY), |inv| {
+                    inv * sigma2
+                }) // K = σ² H⁻¹
+        }
+        None => Matrix3::from_diagonal_element(f64::INFINITY),
+    };
+    (Pose2::new(zeta[0], zeta[1], zeta[2]), covariance)
+}
+
+/// `H = Σ JᵢᵀJᵢ` and `g = Σ Jᵢᵀ rᵢ` on one level at pose `zeta`.
+fn normal_equations(
+    grid: &GridLevel,
+    config: &MatcherConfig,
+    scan: &ScanPoints,
+    zeta: &Vector3<f64>,
+    prior: Option<&Prior>,
+) -> (Matrix3<f64>, Vector3<f64>) {
+    let mut h = Matrix3::zeros();
+    let mut g = Vector3::zeros();
+    let mode = config.mode;
+    let weight = config.reflectivity_weight;
+    let unobserved = config.unobserved_reflectivity;
+    let (c, s) = (zeta[2].cos(), zeta[2].sin());
+    let mut add = |grad: [f64; 2], ds_dtheta: [f64; 2], residual: f64, w: f64| {
+        // J_i = ∇M(S_i) ∂S_i/∂ζ  (eq. 3.9)
+        let j = Vector3::new(
+            grad[0],
+            grad[1],
+            grad[0] * ds_dtheta[0] + grad[1] * ds_dtheta[1],
+        );
+        h += j * j.transpose() * w; // H = Σ JᵢᵀJᵢ (spec FLAG: summed)
+        g += j * (residual * w);
+    };
+    for (p, &refl) in scan.points().iter().zip(scan.reflectivity()) {
+        // Eq. (3.7): S_i(ζ) = R(θ) s_i + t
+        let x = c * p[0] - s * p[1] + zeta[0];
+        let y = s * p[0] + c * p[1] + zeta[1];
+        // ∂S_i/∂θ = (−sinθ s_x − cosθ s_y, cosθ s_x − sinθ s_y)
+        let ds = [-s * p[0] - c * p[1], c * p[0] - s * p[1]];
+        if mode.occupancy() {
+            if let Some(m) = grid.occupancy(x, y) {
+                add(m.gradient, ds, 1.0 - m.value, 1.0);
+            }
+        }
+        if mode.reflectivity() && refl.is_finite() {
+            if let Some(r) = grid.reflectivity(x, y, unobserved) {
+                let w = if mode.occupancy() { weight } else { 1.0 };
+                add(r.gradient, ds, refl - r.value, w); // Eq. (3.6) residual ϱ̄ − R(S_i)
+            }
+        }
+    }
+    if let Some(prior) = prior {
+        let d = Vector3::new(
+            prior.pose.x() - zeta[0],
+            prior.pose.y() - zeta[1],
+            wrap_angle(prior.pose.theta() - zeta[2]),
+        );
+        h += prior.information;
+        g += prior.information * d;
+    }
+    (h, g)
 }

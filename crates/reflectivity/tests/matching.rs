@@ -148,3 +148,46 @@ mod random_offsets {
         }
     }
 }
+
+/// A map cut to its observed box matches exactly like the full map: same cells, same frame.
+#[test]
+fn cropped_levels_match_like_the_full_map() {
+    let config = MatcherConfig {
+        mode: ResidualMode::Combined,
+        ..Default::default()
+    };
+    let mut matcher = ScanMatcher::new(config).unwrap();
+    matcher.process(&scan_from(Pose2::identity()), None);
+    let cropped = matcher.map().cropped_levels(4).unwrap();
+    let full = matcher.map().levels();
+    assert_eq!(cropped.len(), full.len());
+    // The crop is much smaller than the 120 m map and keeps every observed cell.
+    assert!(cropped[0].width() < full[0].width() / 10);
+    for (c, f) in cropped.iter().zip(full) {
+        assert_eq!(c.resolution_m(), f.resolution_m());
+        for (x, y) in [(-2.91, 0.33), (2.93, -1.87), (1.21, 0.67), (0.01, 0.02)] {
+            // Equal up to rounding of the cell fractions (the origins differ).
+            let close = |a: Option<raypath_reflectivity::Sample>,
+                         b: Option<raypath_reflectivity::Sample>| {
+                let (a, b) = (a.unwrap(), b.unwrap());
+                (a.value - b.value).abs() < 1e-9
+                    && (a.gradient[0] - b.gradient[0]).abs() < 1e-6
+                    && (a.gradient[1] - b.gradient[1]).abs() < 1e-6
+            };
+            assert!(close(c.occupancy(x, y), f.occupancy(x, y)), "({x}, {y})");
+            assert!(close(
+                c.reflectivity(x, y, Some(0.0)),
+                f.reflectivity(x, y, Some(0.0))
+            ));
+        }
+    }
+    let offset = Pose2::new(0.12, -0.08, 0.04);
+    let scan = scan_from(offset);
+    let (a, ca) = matcher.match_scan(&scan, Pose2::identity(), None);
+    let (b, cb) =
+        raypath_reflectivity::match_levels(&cropped, &config, &scan, Pose2::identity(), None);
+    assert!(
+        (a.translation() - b.translation()).norm() < 1e-9 && (a.theta() - b.theta()).abs() < 1e-9
+    );
+    assert!((ca - cb).norm() < 1e-6 * ca.norm());
+}
