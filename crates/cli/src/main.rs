@@ -77,6 +77,10 @@ enum Command {
     /// CARMEN log, KITTI sequence, NCLT session, rosbag2 bag or image folder; with ground
     /// truth, the precision–recall summary.
     LoopClosure(commands::loop_closure::Args),
+    /// 2-D lidar SLAM of a raw CARMEN log or a bag: submap front-end, branch-and-bound loop
+    /// closure, robust pose graph; trajectory, corrected log, map and, with a corrected log,
+    /// the relation errors of Kümmerle et al. (2009).
+    Slam(commands::slam::Args),
 }
 
 fn main() -> ExitCode {
@@ -97,6 +101,7 @@ fn main() -> ExitCode {
         Command::ScanMatch(args) => commands::scan_match::run(args),
         Command::CalibrateIntensity(args) => commands::calibrate_intensity::run(args),
         Command::LoopClosure(args) => commands::loop_closure::run(args),
+        Command::Slam(args) => commands::slam::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -243,7 +243,11 @@ fn default_fan(frame: &PlanarFrame) -> bool {
         && (frame.scan.angle_increment_rad - increment).abs() < 1e-9
 }
 
-fn write_carmen(path: &Path, frames: &[PlanarFrame]) -> Result<PathBuf> {
+/// Writes planar frames as a CARMEN log (`FLASER` lines when the beams follow the default
+/// fan, `ROBOTLASER1` otherwise) with lossless numbers ([`NumberFormat::exact`]): the frames'
+/// `world_from_laser` and `world_from_robot` become the logged poses, so frames with corrected
+/// poses give a corrected log. Returns the path written.
+pub fn write_carmen(path: &Path, frames: &[PlanarFrame]) -> Result<PathBuf> {
     let file = std::fs::File::create(path).map_err(|e| Error::io(path, Location::File, e))?;
     let mut writer =
         CarmenWriter::with_format(std::io::BufWriter::new(file), path, NumberFormat::exact());

@@ -19,6 +19,8 @@ mod scan_matching;
 mod segcomp;
 mod sensor_models;
 mod sim;
+mod slam;
+mod slam_map;
 mod synpeb;
 
 use std::path::{Path, PathBuf};
@@ -152,6 +154,11 @@ const EVALUATIONS: &[(&str, &str, EvalFn)] = &[
         "scan-matching",
         "intensity calibration and Hector-style scan matching with occupancy/reflectivity residuals (Khan ch. 3)",
         scan_matching::run,
+    ),
+    (
+        "slam",
+        "2-D SLAM (submaps, branch-and-bound loop closure, robust pose graph) on the SLAM-benchmark logs",
+        slam::run,
     ),
     (
         "place-recognition",

@@ -40,7 +40,7 @@
 //! most `map::record::MAX_VOXELS`).
 
 mod input;
-mod record;
+pub(crate) mod record;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -86,7 +86,7 @@ impl Model {
         }
     }
 
-    fn picture(self) -> MapPicture {
+    pub(crate) fn picture(self) -> MapPicture {
         match self {
             Model::DecayRate => MapPicture::DecayRate,
             Model::Reflection => MapPicture::Reflection,
@@ -148,9 +148,28 @@ const MAX_CELLS: usize = 200_000_000;
 
 /// Runs `raypath map`.
 pub fn run(args: &Args) -> Result<(), Failure> {
+    let mut recording = Recording::open(&args.record, args.json)?;
+    let report = build(args, recording.as_mut())?;
+    if args.json {
+        let mut doc = report.json();
+        super::record::finish(recording, Some(&mut doc))?;
+        println!("{doc}");
+    } else {
+        report.print();
+        super::record::finish(recording, None)?;
+    }
+    Ok(())
+}
+
+/// Builds the map and writes its files without printing: the JSON object `raypath map --json`
+/// prints. `raypath slam` rebuilds its map from the optimised poses through this.
+pub fn build_json(args: &Args) -> Result<serde_json::Value, Failure> {
+    Ok(build(args, None)?.json())
+}
+
+fn build(args: &Args, recording: Option<&mut Recording>) -> Result<Report, Failure> {
     let started = Instant::now();
     let config = check_args(args)?;
-    let mut recording = Recording::open(&args.record, args.json)?;
     let input = Input::read(&args.input, &args.source, args.ray_step, &config)
         .map_err(|e| Failure::input(e, args.json))?;
     let mapping_started = Instant::now();
@@ -195,19 +214,17 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         stats,
     };
     let written = write_outputs(args, &file)?;
-    if let Some(recording) = &mut recording {
+    if let Some(recording) = recording {
         record::record(recording, &input, &file, args.model.picture())?;
     }
-    let report = Report::of(args, &file, dims, mapping_secs, started, written);
-    if args.json {
-        let mut doc = report.json();
-        super::record::finish(recording, Some(&mut doc))?;
-        println!("{doc}");
-    } else {
-        report.print();
-        super::record::finish(recording, None)?;
-    }
-    Ok(())
+    Ok(Report::of(
+        args,
+        &file,
+        dims,
+        mapping_secs,
+        started,
+        written,
+    ))
 }
 
 fn check_args(args: &Args) -> Result<MappingConfig, Failure> {

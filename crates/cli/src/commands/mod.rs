@@ -16,6 +16,7 @@ pub mod scan_match;
 pub mod score_model;
 pub mod segcomp_eval;
 pub mod simulate;
+pub mod slam;
 pub mod source_args;
 
 use std::process::ExitCode;

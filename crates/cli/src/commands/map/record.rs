@@ -66,7 +66,7 @@ pub fn record(
 }
 
 /// `/map`: the picture values as `FLOAT32`, NaN for unknown cells.
-fn grid(
+pub(crate) fn grid(
     recording: &mut Recording,
     stamp: f64,
     stats: &DenseStats2,

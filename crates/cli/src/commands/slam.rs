@@ -1,0 +1,470 @@
+//! `raypath slam`: 2-D lidar SLAM (`raypath_slam`) on a raw CARMEN log or a rosbag2 bag's
+//! LaserScan topic — Hector-style submap front-end, branch-and-bound loop closure, robust
+//! sparse pose graph.
+//!
+//! ```text
+//! raypath slam <log-or-bag> --out DIR [--resolution R] [--ground-truth CORRECTED] [--json]
+//!              [--model decay-rate|reflection|log-odds] [--no-loops] [--no-odometry]
+//!              [--mode occupancy|reflectivity|combined --lut FILE] [--max-range M] [--scans N]
+//!              [--laser …] [--scan-topic T] [--odom-topic T] [--record OUT.mcap]
+//! ```
+//!
+//! Writes into `DIR`: `trajectory.txt` (TUM `t x y z qx qy qz qw`, the laser pose of every
+//! scan in the optimised map frame, which starts at the first scan), `corrected.log` (the
+//! scans as a CARMEN corrected log with the optimised poses), the map rebuilt from the
+//! optimised poses with the sensor model `--model` (`map.pgm` + `map.yaml`, `map.png`,
+//! `map.rpmap`: as `raypath map` writes them) and `loop_closures.csv` (one accepted loop
+//! closure per line).
+//!
+//! `--json` prints `{"scans", "nodes", "submaps", "loop_closures", "rejected_loop_closures",
+//! "seconds", "scans_per_second", "timing", "outputs", "map"}` and, with `--ground-truth`,
+//! `"summary": {"trans_error_m", "trans_error_std_m", "rot_error_deg", "rot_error_std_deg",
+//! "relations"}` over the relations between consecutive referenced scans (Kümmerle et al.
+//! 2009; scans paired with the corrected log by identical readings), `"random_pairs"` (the
+//! same over 1000 seeded random pairs) and `"wrong_loop_closures"` (accepted loop closures
+//! off the reference by more than 0.3 m or 3°, among those whose two scans have a reference
+//! or a referenced scan at most 50 scans away, moved by the front-end's relative motion).
+//!
+//! `--record OUT.mcap`: every scan at its optimised pose (`/tf`, `/scan`), the `/trajectory`,
+//! the rebuilt map as `/map` and the loop closures as lines (`/loops`).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use nalgebra::Point3;
+use raypath_io::foxglove::{frame, topic};
+use raypath_io::sequence::{PlanarFrame, pair_reference};
+use raypath_reflectivity::{IntensityCorrection, ResidualMode};
+use raypath_sensor_models::export::{MapFile, StoredStats};
+use raypath_slam::benchmark::{
+    consecutive_relations, loop_error, random_relations, reference_by_neighbour, relation_errors,
+};
+use raypath_slam::{Slam, SlamConfig, SlamOutput};
+use serde_json::{Value, json};
+
+use super::Failure;
+use super::map::Model;
+use super::record::{RecordArgs, Recording, loop_lines};
+use super::source_args::SourceArgs;
+
+/// Arguments of `raypath slam`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A raw CARMEN log with odometry (plain, .gz or .bz2) or a rosbag2 bag (directory with
+    /// metadata.yaml, or .mcap file) with a LaserScan topic (and odometry or /tf).
+    pub log: PathBuf,
+    /// Output directory (created): trajectory.txt, corrected.log, map.*, loop_closures.csv.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Finest cell of the submaps and cell of the rebuilt map, metres.
+    #[arg(long, default_value_t = 0.05, value_name = "M")]
+    pub resolution: f64,
+    /// A corrected log (or a bag with reference poses) of the same run: report the relation
+    /// errors of Kümmerle et al. (2009) against it.
+    #[arg(long, value_name = "LOG")]
+    pub ground_truth: Option<PathBuf>,
+    /// The sensor model of the rebuilt map.
+    #[arg(long, value_enum, default_value = "reflection")]
+    pub model: Model,
+    /// Residual of the matcher: occupancy (Hector), reflectivity (Khan) or combined.
+    #[arg(long, value_enum, default_value = "occupancy")]
+    pub mode: ModeArg,
+    /// Intensity model JSON from `raypath calibrate-intensity` (reflectivity and combined).
+    #[arg(long, value_name = "FILE")]
+    pub lut: Option<PathBuf>,
+    /// No loop closure: front-end and sequential pose graph only (an ablation).
+    #[arg(long)]
+    pub no_loops: bool,
+    /// Do not use the logged odometry as the initial guess.
+    #[arg(long)]
+    pub no_odometry: bool,
+    /// Readings at or above this range are not used, metres.
+    #[arg(long, default_value_t = 30.0, value_name = "M")]
+    pub max_range: f64,
+    /// Process only the first N scans.
+    #[arg(long, value_name = "N")]
+    pub scans: Option<usize>,
+    /// Print one JSON document on standard output.
+    #[arg(long)]
+    pub json: bool,
+    /// How to read the log and the ground truth.
+    #[command(flatten)]
+    pub source: SourceArgs,
+    /// A Foxglove recording of the run.
+    #[command(flatten)]
+    pub record: RecordArgs,
+}
+
+/// `--mode` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ModeArg {
+    /// Occupancy only (plain Hector).
+    Occupancy,
+    /// Relative reflectivity only (Khan 2017, eq. 3.6).
+    Reflectivity,
+    /// Both residuals.
+    Combined,
+}
+
+impl ModeArg {
+    fn residual(self) -> ResidualMode {
+        match self {
+            ModeArg::Occupancy => ResidualMode::Occupancy,
+            ModeArg::Reflectivity => ResidualMode::Reflectivity,
+            ModeArg::Combined => ResidualMode::Combined,
+        }
+    }
+}
+
+/// Loop closures between scans without a reference are checked against the nearest referenced
+/// scan at most this many scans away, moved by the front-end's relative motion.
+const NEIGHBOUR_GAP: usize = 50;
+/// A loop closure is "wrong" when its relative pose is off the reference by more than this.
+const WRONG_LOOP_M: f64 = 0.3;
+/// … or this many degrees.
+const WRONG_LOOP_DEG: f64 = 3.0;
+
+fn failure(message: impl std::fmt::Display, json: bool) -> Failure {
+    Failure {
+        message: message.to_string(),
+        bad_input: false,
+        json,
+    }
+}
+
+fn config(args: &Args) -> Result<SlamConfig, Failure> {
+    let mut config = SlamConfig::default();
+    config.matcher.map.finest_resolution_m = args.resolution;
+    config.matcher.mode = args.mode.residual();
+    config.filter.max_range_m = args.max_range;
+    config.use_odometry = !args.no_odometry;
+    if args.no_loops {
+        config.loops = None;
+    }
+    config
+        .validate()
+        .map_err(|e| Failure::input(e, args.json))?;
+    Ok(config)
+}
+
+fn read_lut(args: &Args) -> Result<Option<IntensityCorrection>, Failure> {
+    let Some(path) = &args.lut else {
+        if args.mode != ModeArg::Occupancy {
+            return Err(Failure::input(
+                "--mode reflectivity/combined: needs --lut (from raypath calibrate-intensity)",
+                args.json,
+            ));
+        }
+        return Ok(None);
+    };
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Failure::input(format!("{}: {e}", path.display()), args.json))?;
+    serde_json::from_str(&text)
+        .map(Some)
+        .map_err(|e| Failure::input(format!("{}:{}: {e}", path.display(), e.line()), args.json))
+}
+
+/// Runs the subcommand.
+pub fn run(args: &Args) -> Result<(), Failure> {
+    let config = config(args)?;
+    let lut = read_lut(args)?;
+    let mut recording = Recording::open(&args.record, args.json)?;
+    let mut frames = args
+        .source
+        .read_frames(&args.log)
+        .map_err(|e| Failure::input(e, args.json))?;
+    if let Some(n) = args.scans {
+        frames.truncate(n.max(1));
+    }
+    if frames.is_empty() {
+        return Err(Failure::input(
+            format!("{}: no laser scans", args.log.display()),
+            args.json,
+        ));
+    }
+    std::fs::create_dir_all(&args.out).map_err(|e| {
+        failure(
+            format!("{}: cannot create: {e}", args.out.display()),
+            args.json,
+        )
+    })?;
+    let started = Instant::now();
+    let mut slam = Slam::new(config).map_err(|e| Failure::input(e, args.json))?;
+    if let Some(lut) = lut {
+        slam = slam.with_correction(lut);
+    }
+    for (k, frame) in frames.iter().enumerate() {
+        slam.process(frame).map_err(|e| {
+            Failure::input(format!("{}: scan {k}: {e}", args.log.display()), args.json)
+        })?;
+    }
+    let output = slam.finish().map_err(|e| failure(e, args.json))?;
+    let seconds = started.elapsed().as_secs_f64();
+    let outputs = write_outputs(args, &frames, &output)?;
+    let map = rebuild_map(args, &outputs.corrected)?;
+    let evaluation = match &args.ground_truth {
+        Some(path) => Some(evaluate(args, path, &mut frames, &output)?),
+        None => None,
+    };
+    if let Some(recording) = &mut recording {
+        record(recording, &frames, &output, &outputs.map_prefix, args.model)?;
+    }
+    let doc = report(&output, seconds, &outputs, map, evaluation);
+    if args.json {
+        let mut doc = doc;
+        super::record::finish(recording, Some(&mut doc))?;
+        println!("{doc}");
+    } else {
+        print(&doc);
+        super::record::finish(recording, None)?;
+    }
+    Ok(())
+}
+
+struct Outputs {
+    trajectory: PathBuf,
+    corrected: PathBuf,
+    loops: PathBuf,
+    map_prefix: PathBuf,
+}
+
+fn write_outputs(
+    args: &Args,
+    frames: &[PlanarFrame],
+    out: &SlamOutput,
+) -> Result<Outputs, Failure> {
+    let trajectory = args.out.join("trajectory.txt");
+    out.write_tum(&trajectory)
+        .map_err(|e| failure(e, args.json))?;
+    let corrected = args.out.join("corrected.log");
+    out.write_corrected_log(frames, &corrected)
+        .map_err(|e| failure(e, args.json))?;
+    let loops = args.out.join("loop_closures.csv");
+    let mut text = String::from("scan,anchor_scan,node,submap,x,y,theta,score,source\n");
+    for c in &out.loop_closures {
+        let scan = out.node_scan.get(c.node).copied().unwrap_or(usize::MAX);
+        let anchor = out.node_scan.get(c.anchor).copied().unwrap_or(usize::MAX);
+        let p = c.submap_from_sensor;
+        let source = match c.source {
+            raypath_slam::LoopSource::Nearby => "nearby",
+            raypath_slam::LoopSource::PlaceRecognition => "place-recognition",
+        };
+        text.push_str(&format!(
+            "{scan},{anchor},{},{},{},{},{},{},{source}\n",
+            c.node,
+            c.submap,
+            p.x(),
+            p.y(),
+            p.theta(),
+            c.score
+        ));
+    }
+    std::fs::write(&loops, text)
+        .map_err(|e| failure(format!("{}: {e}", loops.display()), args.json))?;
+    Ok(Outputs {
+        trajectory,
+        corrected,
+        loops,
+        map_prefix: args.out.join("map"),
+    })
+}
+
+/// The map of `raypath map` over the corrected log (the optimised poses).
+fn rebuild_map(args: &Args, corrected: &Path) -> Result<Value, Failure> {
+    let map_args = super::map::Args {
+        input: corrected.to_path_buf(),
+        model: args.model,
+        posterior: false,
+        resolution: args.resolution,
+        out: args.out.join("map"),
+        max_range: args.max_range,
+        min_range: 0.0,
+        ray_step: 1,
+        skip_no_returns: true,
+        sparse: false,
+        json: args.json,
+        source: SourceArgs::default(),
+        record: RecordArgs::default(),
+    };
+    super::map::build_json(&map_args)
+}
+
+/// Relation errors against the ground truth and the check of every loop closure.
+fn evaluate(
+    args: &Args,
+    path: &Path,
+    frames: &mut [PlanarFrame],
+    out: &SlamOutput,
+) -> Result<Value, Failure> {
+    let reference = args
+        .source
+        .read_frames(path)
+        .map_err(|e| Failure::input(e, args.json))?;
+    let paired = pair_reference(frames, &reference);
+    if paired < 2 {
+        return Err(Failure::input(
+            format!(
+                "{}: fewer than two scans pair with {} (identical readings)",
+                path.display(),
+                args.log.display()
+            ),
+            args.json,
+        ));
+    }
+    let truth: Vec<_> = frames.iter().map(|f| f.reference).collect();
+    let referenced: Vec<usize> = (0..frames.len()).filter(|&i| truth[i].is_some()).collect();
+    let summary = relation_errors(
+        &truth,
+        &out.world_from_sensor,
+        &consecutive_relations(&referenced),
+    );
+    let random = relation_errors(
+        &truth,
+        &out.world_from_sensor,
+        &random_relations(&referenced, 1000, 1),
+    );
+    let local: Vec<_> = out.scans.iter().map(|s| s.local).collect();
+    let truth = reference_by_neighbour(&truth, &local, NEIGHBOUR_GAP);
+    let (mut checked, mut wrong) = (0, 0);
+    for c in &out.loop_closures {
+        let (Some(&a), Some(&b)) = (out.node_scan.get(c.anchor), out.node_scan.get(c.node)) else {
+            continue;
+        };
+        if let Some((t, r)) = loop_error(truth[a], truth[b], c.submap_from_sensor) {
+            checked += 1;
+            if t > WRONG_LOOP_M || r.to_degrees() > WRONG_LOOP_DEG {
+                wrong += 1;
+            }
+        }
+    }
+    Ok(json!({
+        "paired_scans": paired,
+        "summary": summary,
+        "random_pairs": random,
+        "loop_closures_checked": checked,
+        "wrong_loop_closures": wrong,
+    }))
+}
+
+fn report(
+    out: &SlamOutput,
+    seconds: f64,
+    outputs: &Outputs,
+    map: Value,
+    evaluation: Option<Value>,
+) -> Value {
+    let mut doc = json!({
+        "scans": out.scans.len(),
+        "nodes": out.nodes.len(),
+        "submaps": out.submaps.len(),
+        "loop_closures": out.loop_closures.len(),
+        "rejected_loop_closures": out.rejected_loop_closures.len(),
+        "seconds": seconds,
+        "scans_per_second": out.scans.len() as f64 / seconds.max(1e-9),
+        "timing": out.stats,
+        "outputs": {
+            "trajectory": outputs.trajectory,
+            "corrected_log": outputs.corrected,
+            "loop_closures": outputs.loops,
+        },
+        "map": map,
+    });
+    if let (Some(e), Some(obj)) = (evaluation, doc.as_object_mut()) {
+        for key in [
+            "paired_scans",
+            "summary",
+            "random_pairs",
+            "loop_closures_checked",
+            "wrong_loop_closures",
+        ] {
+            obj.insert(key.into(), e[key].clone());
+        }
+    }
+    doc
+}
+
+fn print(doc: &Value) {
+    println!(
+        "{} scans, {} nodes, {} submaps, {} loop closures ({} rejected): {:.2} s, {:.0} scans/s",
+        doc["scans"],
+        doc["nodes"],
+        doc["submaps"],
+        doc["loop_closures"],
+        doc["rejected_loop_closures"],
+        doc["seconds"].as_f64().unwrap_or(f64::NAN),
+        doc["scans_per_second"].as_f64().unwrap_or(f64::NAN),
+    );
+    println!(
+        "trajectory: {}",
+        doc["outputs"]["trajectory"].as_str().unwrap_or("?")
+    );
+    println!(
+        "corrected log: {}",
+        doc["outputs"]["corrected_log"].as_str().unwrap_or("?")
+    );
+    println!(
+        "map: {}",
+        doc["map"]["outputs"]["png"]
+            .as_str()
+            .unwrap_or("(see map.*)")
+    );
+    if let Ok(s) = serde_json::from_value::<SummaryView>(doc["summary"].clone()) {
+        println!(
+            "relation error over {} consecutive reference pairs: {:.3} ± {:.3} m, {:.2} ± {:.2}°; \
+             {} of {} checked loop closures wrong",
+            s.relations,
+            s.trans_error_m,
+            s.trans_error_std_m,
+            s.rot_error_deg,
+            s.rot_error_std_deg,
+            doc["wrong_loop_closures"],
+            doc["loop_closures_checked"],
+        );
+    }
+}
+
+/// The `summary` object read back for printing.
+#[derive(serde::Deserialize)]
+struct SummaryView {
+    trans_error_m: f64,
+    trans_error_std_m: f64,
+    rot_error_deg: f64,
+    rot_error_std_deg: f64,
+    relations: usize,
+}
+
+/// Scans at the optimised poses, the trajectory, the rebuilt map and the loop closures.
+fn record(
+    recording: &mut Recording,
+    frames: &[PlanarFrame],
+    out: &SlamOutput,
+    map_prefix: &Path,
+    model: Model,
+) -> Result<(), Failure> {
+    let mut robots = Vec::with_capacity(frames.len());
+    for (frame, world_from_laser) in frames.iter().zip(&out.world_from_sensor) {
+        let robot_from_laser = frame.robot_from_laser();
+        let world_from_robot = *world_from_laser * robot_from_laser.inverse();
+        recording.planar_scan(
+            frame.stamp_secs,
+            &world_from_robot,
+            &robot_from_laser,
+            &frame.scan,
+        )?;
+        robots.push(world_from_robot);
+    }
+    let end = recording.end_stamp();
+    recording.planar_trajectory(topic::TRAJECTORY, end, &robots)?;
+    let rpmap = map_prefix.with_extension("rpmap");
+    let file = MapFile::read_file(&rpmap).map_err(|e| failure(e, false))?;
+    if let StoredStats::Planar(stats) = &file.stats {
+        super::map::record::grid(recording, end, stats, model.picture())?;
+    }
+    let at = |node: usize| out.nodes.get(node).map(|p| Point3::new(p.x(), p.y(), 0.0));
+    let pairs: Vec<_> = out
+        .loop_closures
+        .iter()
+        .filter_map(|c| Some((at(c.anchor)?, at(c.node)?)))
+        .collect();
+    recording.scene(topic::LOOPS, end, frame::MAP, &loop_lines(&pairs))
+}

@@ -1,0 +1,133 @@
+//! Runs SLAM on a raw CARMEN log (or a rosbag2 bag) and, given the corrected log, prints the
+//! relation errors of Kümmerle et al. (2009).
+//!
+//! ```text
+//! cargo run --release -p raypath-slam --example slam_log -- RAW.clf [CORRECTED.log] [--no-loops]
+//! ```
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use raypath_io::sequence::{PlanarOptions, pair_reference, read_planar};
+use raypath_slam::benchmark::{consecutive_relations, random_relations, relation_errors};
+use raypath_slam::{Slam, SlamConfig};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let no_loops = args.iter().any(|a| a == "--no-loops");
+    let files: Vec<PathBuf> = args
+        .iter()
+        .filter(|a| !a.starts_with("--"))
+        .map(PathBuf::from)
+        .collect();
+    let Some(raw) = files.first() else {
+        eprintln!("usage: slam_log RAW [CORRECTED] [--no-loops]");
+        return Ok(());
+    };
+    let options = PlanarOptions::default();
+    let mut frames = read_planar(raw, &options)?;
+    if let Some(corrected) = files.get(1) {
+        let reference = read_planar(corrected, &options)?;
+        let paired = pair_reference(&mut frames, &reference);
+        eprintln!(
+            "{paired} of {} scans paired with the reference",
+            frames.len()
+        );
+    }
+    let mut config = SlamConfig::default();
+    if no_loops {
+        config.loops = None;
+    }
+    // Quick knobs for experiments: SLAM_RES, SLAM_SEQ (σ_t of sequential edges), SLAM_LOOP
+    // (σ_t of loop edges), SLAM_EVERY (loop search every n nodes), SLAM_NODES (per submap).
+    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
+    if let Some(r) = env("SLAM_RES") {
+        config.matcher.map.finest_resolution_m = r;
+    }
+    if let Some(s) = env("SLAM_SEQ") {
+        config.sequential_sigma = [s, s, s / 2.0];
+    }
+    if let Some(s) = env("SLAM_LOOP") {
+        config.loop_sigma = [s, s, s / 2.0];
+    }
+    if let (Some(e), Some(l)) = (env("SLAM_EVERY"), config.loops.as_mut()) {
+        l.every_nodes = e as usize;
+    }
+    if let Some(w) = env("SLAM_ROT") {
+        config.submaps.rotation_window_rad = w;
+    }
+    if env("SLAM_NO_INTRA").is_some() {
+        config.intra_submap_edges = false;
+    }
+    if let Some(n) = env("SLAM_NODES") {
+        config.submaps.nodes_per_submap = n as usize;
+    }
+    let t0 = Instant::now();
+    let mut slam = Slam::new(config)?;
+    for f in &frames {
+        slam.process(f)?;
+    }
+    let out = slam.finish()?;
+    let secs = t0.elapsed().as_secs_f64();
+    println!(
+        "{} scans, {} nodes, {} submaps, {} loop closures ({} rejected) in {secs:.2} s ({:.0} scans/s)",
+        out.scans.len(),
+        out.nodes.len(),
+        out.submaps.len(),
+        out.loop_closures.len(),
+        out.rejected_loop_closures.len(),
+        out.scans.len() as f64 / secs
+    );
+    println!("{:?}", out.stats);
+    let reference: Vec<_> = frames.iter().map(|f| f.reference).collect();
+    let referenced: Vec<usize> = (0..frames.len())
+        .filter(|&i| reference[i].is_some())
+        .collect();
+    if !referenced.is_empty() {
+        let c = relation_errors(
+            &reference,
+            &out.world_from_sensor,
+            &consecutive_relations(&referenced),
+        );
+        let r = relation_errors(
+            &reference,
+            &out.world_from_sensor,
+            &random_relations(&referenced, 1000, 1),
+        );
+        let odo: Vec<_> = frames.iter().map(|f| f.world_from_laser).collect();
+        let o = relation_errors(&reference, &odo, &consecutive_relations(&referenced));
+        println!("consecutive: {c:?}\nrandom: {r:?}\nodometry consecutive: {o:?}");
+        if std::env::var("SLAM_WORST").is_ok() {
+            for (i, j) in consecutive_relations(&referenced) {
+                let (gi, gj) = (
+                    reference[i].unwrap_or_default(),
+                    reference[j].unwrap_or_default(),
+                );
+                let (ei, ej) = (out.world_from_sensor[i], out.world_from_sensor[j]);
+                let e = (gi.inverse() * gj).inverse() * (ei.inverse() * ej);
+                if e.translation().norm() > 0.2 || e.theta().abs() > 0.05 {
+                    let odo = (frames[i].world_from_laser.inverse() * frames[j].world_from_laser)
+                        .inverse()
+                        * (gi.inverse() * gj);
+                    println!(
+                        "relation {i}-{j}: error {:.3} m {:.1}°, odometry error {:.3} m {:.1}°, ref step {:.2} m {:.1}°",
+                        e.translation().norm(),
+                        e.theta().to_degrees(),
+                        odo.translation().norm(),
+                        odo.theta().to_degrees(),
+                        (gi.inverse() * gj).translation().norm(),
+                        (gi.inverse() * gj).theta().to_degrees()
+                    );
+                }
+            }
+        }
+        let refs: Vec<_> = referenced.iter().filter_map(|&i| reference[i]).collect();
+        let est: Vec<_> = referenced
+            .iter()
+            .map(|&i| out.world_from_sensor[i])
+            .collect();
+        let a = raypath_reflectivity::benchmark::aligned_errors(&refs, &est);
+        println!("aligned: {a:?}");
+    }
+    Ok(())
+}

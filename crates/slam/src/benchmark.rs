@@ -1,0 +1,264 @@
+//! The SLAM benchmark metric of Kümmerle et al. (2009, "On measuring the accuracy of SLAM
+//! algorithms"): errors of relative poses over *relations* — pairs of scans whose reference
+//! relative pose is known — translational and rotational, mean ± standard deviation.
+//!
+//! The benchmark's own relation files are not distributed with the logs we read, so relations
+//! are derived from a reference trajectory (the corrected log paired scan by scan with the raw
+//! log, [`raypath_io::sequence::pair_reference`]):
+//!
+//! * **consecutive**: every pair of consecutive referenced scans (local accuracy, as in the
+//!   benchmark's relations between nearby poses);
+//! * **random pairs**: seeded uniform pairs of referenced scans anywhere in the log (global
+//!   consistency, as in the benchmark's relations across loops).
+//!
+//! The relation set is written into every report so the numbers can be reproduced.
+
+use raypath_geometry::{Pose2, wrap_angle};
+use serde::Serialize;
+
+/// Mean and standard deviation of the relation errors: the JSON keys are a contract of
+/// `raypath slam --ground-truth`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ErrorSummary {
+    /// Mean translational error, metres.
+    pub trans_error_m: f64,
+    /// Its standard deviation, metres.
+    pub trans_error_std_m: f64,
+    /// Mean absolute rotational error, degrees.
+    pub rot_error_deg: f64,
+    /// Its standard deviation, degrees.
+    pub rot_error_std_deg: f64,
+    /// Relations evaluated.
+    pub relations: usize,
+}
+
+/// Relations `(i, j)` between consecutive entries of `referenced` (indices of scans with a
+/// reference pose, increasing).
+pub fn consecutive_relations(referenced: &[usize]) -> Vec<(usize, usize)> {
+    referenced.windows(2).map(|w| (w[0], w[1])).collect()
+}
+
+/// `count` seeded pseudo-random relations between distinct entries of `referenced` (ChaCha8 on
+/// `seed`; the same seed gives the same relations).
+pub fn random_relations(referenced: &[usize], count: usize, seed: u64) -> Vec<(usize, usize)> {
+    use rand::{Rng, SeedableRng};
+    let n = referenced.len();
+    if n < 2 {
+        return Vec::new();
+    }
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    (0..count)
+        .map(|_| {
+            let a = rng.random_range(0..n);
+            let mut b = rng.random_range(0..n - 1);
+            if b >= a {
+                b += 1;
+            }
+            (referenced[a.min(b)], referenced[a.max(b)])
+        })
+        .collect()
+}
+
+/// Relation errors of `estimate` against `reference` (index-aligned; `None` where a scan has
+/// no reference). The translational error of relation `(i, j)` is `‖t(δ_ref⁻¹ δ_est)‖` with
+/// `δ = x_i⁻¹ x_j`, the rotational error the absolute angle of the same pose (Kümmerle et al.
+/// 2009, eq. 3 split into its parts).
+pub fn relation_errors(
+    reference: &[Option<Pose2>],
+    estimate: &[Pose2],
+    relations: &[(usize, usize)],
+) -> ErrorSummary {
+    let mut t = Vec::with_capacity(relations.len());
+    let mut r = Vec::with_capacity(relations.len());
+    for &(i, j) in relations {
+        let (Some(Some(gi)), Some(Some(gj)), Some(ei), Some(ej)) = (
+            reference.get(i),
+            reference.get(j),
+            estimate.get(i),
+            estimate.get(j),
+        ) else {
+            continue;
+        };
+        let e = (gi.inverse() * *gj).inverse() * (ei.inverse() * *ej);
+        t.push(e.translation().norm());
+        r.push(wrap_angle(e.theta()).abs().to_degrees());
+    }
+    let (tm, ts) = mean_std(&t);
+    let (rm, rs) = mean_std(&r);
+    ErrorSummary {
+        trans_error_m: tm,
+        trans_error_std_m: ts,
+        rot_error_deg: rm,
+        rot_error_std_deg: rs,
+        relations: t.len(),
+    }
+}
+
+fn mean_std(v: &[f64]) -> (f64, f64) {
+    if v.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n;
+    (mean, var.sqrt())
+}
+
+/// Whether a loop closure agrees with the reference: the error of its relative pose between
+/// the two scans (reference relative pose vs the constraint) is below `max_translation_m` and
+/// `max_rotation_rad`. `None` when either scan has no reference.
+pub fn loop_error(
+    reference_a: Option<Pose2>,
+    reference_b: Option<Pose2>,
+    measured_a_from_b: Pose2,
+) -> Option<(f64, f64)> {
+    let (a, b) = (reference_a?, reference_b?);
+    let e = (a.inverse() * b).inverse() * measured_a_from_b;
+    Some((e.translation().norm(), wrap_angle(e.theta()).abs()))
+}
+
+/// Self-consistency of a map without reference poses: of the confidently occupied cells of
+/// each finished submap (log-odds > 2, finest level) that fall, at the optimised submap poses,
+/// on confidently observed cells of another submap that shares no node with it, the fraction
+/// that the other submap holds confidently **free** (log-odds < −2). Walls seen through free
+/// space of another visit are what a broken loop (or a missed one) leaves behind; a
+/// consistent map scores close to 0. Returns `(fraction, cells compared)`.
+pub fn submap_disagreement(output: &crate::SlamOutput) -> (f64, usize) {
+    const CONFIDENT: f32 = 2.0;
+    let submaps = &output.submaps;
+    let pose = |s: &crate::Submap| output.nodes.get(s.anchor()).copied();
+    let (mut conflicts, mut compared) = (0usize, 0usize);
+    for (a, sa) in submaps.iter().enumerate() {
+        let (Some(world_from_a), Some(la)) = (pose(sa), sa.levels().first()) else {
+            continue;
+        };
+        let (res, o) = (la.resolution_m(), la.origin());
+        for (b, sb) in submaps.iter().enumerate() {
+            let (Some(world_from_b), Some(lb)) = (pose(sb), sb.levels().first()) else {
+                continue;
+            };
+            if a == b || sa.nodes().iter().any(|n| sb.nodes().contains(n)) {
+                continue;
+            }
+            let b_from_a = world_from_b.inverse() * world_from_a;
+            let reach = (la.width().max(la.height()) + lb.width().max(lb.height())) as f64 * res;
+            let (ca, cb) = (sa.centre(), sb.centre());
+            let ca_in_b = b_from_a * nalgebra::Point2::new(ca[0], ca[1]);
+            if (ca_in_b.coords - nalgebra::Vector2::new(cb[0], cb[1])).norm() > reach / 2.0 {
+                continue;
+            }
+            for j in 0..la.height() {
+                for i in 0..la.width() {
+                    if la.log_odds(i, j) <= CONFIDENT {
+                        continue;
+                    }
+                    let p = nalgebra::Point2::new(
+                        o[0] + (i as f64 + 0.5) * res,
+                        o[1] + (j as f64 + 0.5) * res,
+                    );
+                    let q = b_from_a * p;
+                    let Some((bi, bj)) = lb.cell_of(q.x, q.y) else {
+                        continue;
+                    };
+                    let l = lb.log_odds(bi, bj);
+                    if l.abs() > CONFIDENT {
+                        compared += 1;
+                        if l < -CONFIDENT {
+                            conflicts += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let fraction = if compared == 0 {
+        0.0
+    } else {
+        conflicts as f64 / compared as f64
+    };
+    (fraction, compared)
+}
+
+/// For scans without a reference pose, a reference **by neighbour**: the nearest referenced
+/// scan (by index, at most `max_gap` scans away) composed with the front-end's relative
+/// motion to it (`local`: the front-end's poses, accurate over a few scans). Used to check
+/// loop closures whose scans are not in the corrected log.
+pub fn reference_by_neighbour(
+    reference: &[Option<Pose2>],
+    local: &[Pose2],
+    max_gap: usize,
+) -> Vec<Option<Pose2>> {
+    let n = reference.len().min(local.len());
+    (0..n)
+        .map(|k| {
+            if let Some(r) = reference[k] {
+                return Some(r);
+            }
+            let lo = k.saturating_sub(max_gap);
+            let hi = (k + max_gap).min(n - 1);
+            let nearest = (lo..=hi)
+                .filter(|&m| reference[m].is_some())
+                .min_by_key(|&m| m.abs_diff(k))?;
+            Some(reference[nearest]? * (local[nearest].inverse() * local[k]))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_perfect_estimate_has_zero_error_and_a_shifted_one_its_shift() {
+        let truth: Vec<Pose2> = (0..20)
+            .map(|k| Pose2::new(k as f64 * 0.5, (k as f64 * 0.3).sin(), k as f64 * 0.1))
+            .collect();
+        let reference: Vec<Option<Pose2>> = truth.iter().map(|p| Some(*p)).collect();
+        let idx: Vec<usize> = (0..20).collect();
+        let rel = consecutive_relations(&idx);
+        assert_eq!(rel.len(), 19);
+        let s = relation_errors(&reference, &truth, &rel);
+        assert!(s.trans_error_m < 1e-12 && s.rot_error_deg < 1e-9);
+        // The whole trajectory moved rigidly: relative poses unchanged.
+        let moved: Vec<Pose2> = truth
+            .iter()
+            .map(|p| Pose2::new(3.0, -2.0, 1.0) * *p)
+            .collect();
+        let s = relation_errors(&reference, &moved, &random_relations(&idx, 50, 7));
+        assert!(s.trans_error_m < 1e-9 && s.relations == 50);
+        // One scan displaced by 0.1 m: the two relations touching it are off by 0.1 m.
+        let mut bad = truth.clone();
+        bad[10] = bad[10] * Pose2::new(0.1, 0.0, 0.0);
+        let s = relation_errors(&reference, &bad, &rel);
+        assert!((s.trans_error_m - 0.2 / 19.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn random_relations_are_seeded_and_distinct() {
+        let idx: Vec<usize> = (0..100).map(|k| 3 * k).collect();
+        let a = random_relations(&idx, 200, 1);
+        assert_eq!(a, random_relations(&idx, 200, 1));
+        assert_ne!(a, random_relations(&idx, 200, 2));
+        assert!(a.iter().all(|(i, j)| i < j && i % 3 == 0 && j % 3 == 0));
+    }
+
+    #[test]
+    fn neighbours_lend_their_reference_moved_by_the_local_motion() {
+        let local: Vec<Pose2> = (0..10).map(|k| Pose2::new(k as f64, 0.0, 0.0)).collect();
+        let world = Pose2::new(5.0, 5.0, 1.0);
+        let mut reference = vec![None; 10];
+        reference[4] = Some(world * local[4]);
+        let near = reference_by_neighbour(&reference, &local, 3);
+        assert!(near[0].is_none() && near[8].is_none());
+        for k in 1..=7 {
+            let p = near[k].unwrap();
+            let truth = world * local[k];
+            assert!(
+                (p.translation() - truth.translation()).norm() < 1e-12,
+                "{k}"
+            );
+        }
+        let err = loop_error(near[2], near[6], local[2].inverse() * local[6]).unwrap();
+        assert!(err.0 < 1e-12 && err.1 < 1e-12);
+    }
+}

@@ -1,0 +1,306 @@
+//! Loop closure: find finished submaps a new node may see, verify each candidate by a
+//! correlative branch-and-bound search (Olson 2009; Hess et al. 2016, §V) and refine it by the
+//! Gauss–Newton matcher on the submap's grids.
+//!
+//! Candidates come from two sources:
+//!
+//! * **nearby submaps**: finished submaps whose centre lies within a search radius of the
+//!   node's current estimate; radius and window grow with the path since the last accepted loop
+//!   closure, since the estimate's uncertainty grows with it;
+//! * **place recognition** (`raypath-place-recognition`): the node scan's planar polar context
+//!   (a Scan-Context-like descriptor) against the nodes of finished submaps, wherever the
+//!   estimate puts them; a candidate is searched over the full rotation around the matched
+//!   node.
+//!
+//! A candidate becomes a loop constraint when the best pose of the search reaches the minimum
+//! score and the Gauss–Newton refinement stays within [`LoopSearchConfig::max_refinement_m`] of
+//! it. Wrong constraints that pass both are left to the robust pose graph (see
+//! [`crate::graph`]).
+
+use raypath_geometry::{Pose2, Scan2};
+use raypath_place_recognition::{PolarConfig, PolarContext, PolarDescription};
+use raypath_reflectivity::{MatcherConfig, ScanPoints, match_levels};
+
+use crate::config::LoopSearchConfig;
+use crate::correlative::{SearchWindow, match_scan};
+use crate::error::Result;
+use crate::submap::Submap;
+
+/// Where a loop candidate came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LoopSource {
+    /// A finished submap near the node's current estimate.
+    Nearby,
+    /// Place recognition (planar polar context).
+    PlaceRecognition,
+}
+
+/// An accepted loop constraint: node `node` seen in submap `submap` at `submap_from_sensor`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LoopClosure {
+    /// The node (scan) that closes the loop.
+    pub node: usize,
+    /// The finished submap it was matched against (index into [`crate::SlamOutput::submaps`]).
+    pub submap: usize,
+    /// The submap's anchor node (the other end of the pose-graph edge).
+    pub anchor: usize,
+    /// The node's pose in the submap frame.
+    pub submap_from_sensor: Pose2,
+    /// Branch-and-bound score (mean probability of the points).
+    pub score: f64,
+    /// Where the candidate came from.
+    pub source: LoopSource,
+    /// The index of the pose-graph edge.
+    pub edge: usize,
+}
+
+/// A candidate pair to verify.
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    submap: usize,
+    initial: Pose2,
+    window: SearchWindow,
+    source: LoopSource,
+}
+
+/// Counters of the loop search.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct LoopStats {
+    /// Node–submap pairs searched.
+    pub candidates: usize,
+    /// Of which from place recognition.
+    pub place_recognition_candidates: usize,
+    /// Pairs whose best pose reached the minimum score.
+    pub matched: usize,
+    /// Matches refused because the refinement moved too far.
+    pub refinement_rejected: usize,
+}
+
+/// The loop closer's state: polar-context descriptions of the nodes.
+#[derive(Debug)]
+pub(crate) struct LoopCloser {
+    config: LoopSearchConfig,
+    polar: Option<PolarContext>,
+    descriptions: Vec<Option<PolarDescription>>,
+    thinned: Vec<[f64; 2]>,
+    pub stats: LoopStats,
+}
+
+impl LoopCloser {
+    pub fn new(config: LoopSearchConfig, max_range_m: f64) -> Result<Self> {
+        let polar = if config.place_recognition {
+            Some(PolarContext::new(PolarConfig {
+                max_range_m: max_range_m.min(20.0),
+                ..PolarConfig::default()
+            })?)
+        } else {
+            None
+        };
+        Ok(Self {
+            config,
+            polar,
+            descriptions: Vec::new(),
+            thinned: Vec::new(),
+            stats: LoopStats::default(),
+        })
+    }
+
+    /// Describes node `node`'s scan for place recognition (call for every node, in order).
+    pub fn describe(&mut self, node: usize, scan: &Scan2) {
+        let d = self.polar.as_ref().and_then(|p| p.describe_scan(scan).ok());
+        if self.descriptions.len() <= node {
+            self.descriptions.resize(node + 1, None);
+        }
+        self.descriptions[node] = d;
+    }
+
+    /// Searches the finished `submaps` for loops of node `node` at world pose `world_from_node`
+    /// (`nodes`: current world poses of all nodes; `node_submap`: the finished submap each node
+    /// belongs to, if any; `travel_m`: path since the last accepted loop).
+    #[allow(clippy::too_many_arguments)]
+    pub fn search(
+        &mut self,
+        node: usize,
+        points: &ScanPoints,
+        nodes: &[Pose2],
+        node_submap: &[Option<usize>],
+        submaps: &[Submap],
+        matcher: &MatcherConfig,
+        travel_m: f64,
+    ) -> Vec<(usize, Pose2, f64, LoopSource)> {
+        let Some(&world_from_node) = nodes.get(node) else {
+            return Vec::new();
+        };
+        let candidates =
+            self.candidates(node, world_from_node, nodes, node_submap, submaps, travel_m);
+        if candidates.is_empty() {
+            return Vec::new();
+        }
+        thin(points.points(), self.config.thinning_m, &mut self.thinned);
+        let mut out = Vec::new();
+        for c in candidates {
+            self.stats.candidates += 1;
+            if c.source == LoopSource::PlaceRecognition {
+                self.stats.place_recognition_candidates += 1;
+            }
+            let Some(submap) = submaps.get(c.submap) else {
+                continue;
+            };
+            let Some(m) = match_scan(
+                submap.precomputed(),
+                &self.thinned,
+                c.initial,
+                &c.window,
+                &self.config.correlative,
+            ) else {
+                continue;
+            };
+            self.stats.matched += 1;
+            let (refined, _) =
+                match_levels(submap.levels(), matcher, points, m.submap_from_sensor, None);
+            let jump = (m.submap_from_sensor.inverse() * refined)
+                .translation()
+                .norm();
+            if !refined.is_finite() || jump > self.config.max_refinement_m {
+                self.stats.refinement_rejected += 1;
+                continue;
+            }
+            out.push((c.submap, refined, m.score, c.source));
+        }
+        out
+    }
+
+    fn candidates(
+        &self,
+        node: usize,
+        world_from_node: Pose2,
+        nodes: &[Pose2],
+        node_submap: &[Option<usize>],
+        submaps: &[Submap],
+        travel_m: f64,
+    ) -> Vec<Candidate> {
+        let c = &self.config;
+        let growth = c.radius_growth * travel_m;
+        let radius = c.search_radius_m + growth;
+        let window = SearchWindow {
+            linear_m: (c.linear_window_m + growth).min(c.max_linear_window_m),
+            angular_rad: c.angular_window_rad,
+        };
+        let recent = |s: &Submap| {
+            s.nodes()
+                .last()
+                .is_none_or(|&last| last + c.min_node_gap > node)
+        };
+        let mut out = Vec::new();
+        for (k, s) in submaps.iter().enumerate() {
+            let Some(&world_from_submap) = nodes.get(s.anchor()) else {
+                continue;
+            };
+            if recent(s) {
+                continue;
+            }
+            let centre = world_from_submap * nalgebra::Point2::new(s.centre()[0], s.centre()[1]);
+            let d = (centre.coords - world_from_node.translation()).norm();
+            if d <= radius {
+                out.push((
+                    d,
+                    Candidate {
+                        submap: k,
+                        initial: world_from_submap.inverse() * world_from_node,
+                        window,
+                        source: LoopSource::Nearby,
+                    },
+                ));
+            }
+        }
+        // The nearest submaps first, at most `max_candidates` of them.
+        out.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut out: Vec<Candidate> = out
+            .into_iter()
+            .take(c.max_candidates)
+            .map(|(_, candidate)| candidate)
+            .collect();
+        if let Some(pr) = self.place_recognition(node, nodes, node_submap, submaps) {
+            if !out.iter().any(|o| o.submap == pr.submap) {
+                out.push(pr);
+            }
+        }
+        out
+    }
+
+    /// The best place-recognition match among nodes of finished submaps, if close enough.
+    fn place_recognition(
+        &self,
+        node: usize,
+        nodes: &[Pose2],
+        node_submap: &[Option<usize>],
+        submaps: &[Submap],
+    ) -> Option<Candidate> {
+        let c = &self.config;
+        let query = self.descriptions.get(node)?.as_ref()?;
+        let limit = node.checked_sub(c.min_node_gap)?;
+        // Ring keys first (cheap, heading-free), then the exact distance of the 5 nearest.
+        let mut best: Vec<(f64, usize)> = Vec::with_capacity(6);
+        for (j, d) in self.descriptions.iter().enumerate().take(limit + 1) {
+            let (Some(d), Some(Some(_))) = (d, node_submap.get(j)) else {
+                continue;
+            };
+            let k: f64 = query
+                .ring_key()
+                .iter()
+                .zip(d.ring_key())
+                .map(|(a, b)| (a - b) * (a - b))
+                .sum();
+            if best.len() < 5 || k < best[best.len() - 1].0 {
+                let at = best.partition_point(|b| b.0 <= k);
+                best.insert(at, (k, j));
+                best.truncate(5);
+            }
+        }
+        let (distance, j) = best
+            .iter()
+            .filter_map(|&(_, j)| Some((query.distance(self.descriptions[j].as_ref()?).0, j)))
+            .min_by(|a, b| a.0.total_cmp(&b.0))?;
+        if distance > c.place_recognition_max_distance {
+            return None;
+        }
+        let submap = (*node_submap.get(j)?)?;
+        let world_from_submap = *nodes.get(submaps.get(submap)?.anchor())?;
+        Some(Candidate {
+            submap,
+            initial: world_from_submap.inverse() * *nodes.get(j)?,
+            window: SearchWindow {
+                linear_m: c.place_recognition_window_m,
+                angular_rad: std::f64::consts::PI,
+            },
+            source: LoopSource::PlaceRecognition,
+        })
+    }
+}
+
+/// Keeps one point per `spacing` metres along the scan (points in scan order).
+fn thin(points: &[[f64; 2]], spacing: f64, out: &mut Vec<[f64; 2]>) {
+    out.clear();
+    let s2 = spacing * spacing;
+    for p in points {
+        match out.last() {
+            Some(q) if (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) < s2 => {}
+            _ => out.push(*p),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::thin;
+
+    #[test]
+    fn thinning_keeps_one_point_per_spacing() {
+        let pts: Vec<[f64; 2]> = (0..100).map(|i| [i as f64 * 0.01, 0.0]).collect();
+        let mut out = Vec::new();
+        thin(&pts, 0.1, &mut out);
+        assert_eq!(out.len(), 10);
+        assert!(out.windows(2).all(|w| (w[1][0] - w[0][0]) >= 0.1 - 1e-12));
+    }
+}

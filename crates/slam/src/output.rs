@@ -1,0 +1,116 @@
+//! What a SLAM run returns: the optimised pose of every scan, the pose graph, the submaps and
+//! the loop closures, with writers for TUM trajectories and corrected CARMEN logs.
+
+use std::path::Path;
+
+use raypath_geometry::Pose2;
+use raypath_io::sequence::PlanarFrame;
+
+use crate::error::{Result, SlamError};
+use crate::graph::PoseGraph;
+use crate::loops::{LoopClosure, LoopStats};
+use crate::submap::Submap;
+
+/// One processed scan.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScanPose {
+    /// Time of the scan, seconds.
+    pub stamp_secs: f64,
+    /// The front-end's pose of the scan in its local (never corrected) frame.
+    pub local: Pose2,
+    /// The latest node at or before this scan.
+    pub node: usize,
+    /// Whether this scan is that node.
+    pub is_node: bool,
+}
+
+/// Timings and counters of a run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct SlamStats {
+    /// Time in scan matching and submap insertion, seconds.
+    pub frontend_seconds: f64,
+    /// Time in loop search and verification, seconds.
+    pub loop_seconds: f64,
+    /// Time in pose-graph optimisation, seconds.
+    pub optimise_seconds: f64,
+    /// Number of optimisations.
+    pub optimisations: usize,
+    /// Final χ² of the last optimisation.
+    pub final_chi2: f64,
+    /// Loop-search counters.
+    pub loops: LoopStats,
+}
+
+/// The result of [`crate::Slam::finish`].
+#[derive(Debug)]
+pub struct SlamOutput {
+    /// Every processed scan, in input order.
+    pub scans: Vec<ScanPose>,
+    /// The optimised `world_from_sensor` of every scan (index-aligned with `scans`); the world
+    /// frame is the first scan's sensor frame.
+    pub world_from_sensor: Vec<Pose2>,
+    /// The optimised node poses (`world_from_sensor` of the node scans).
+    pub nodes: Vec<Pose2>,
+    /// The scan index of each node.
+    pub node_scan: Vec<usize>,
+    /// The finished submaps, in the order they were finished.
+    pub submaps: Vec<Submap>,
+    /// Accepted loop closures (robust weight at the final optimisation at least
+    /// [`crate::SlamConfig::reject_weight`]).
+    pub loop_closures: Vec<LoopClosure>,
+    /// Loop closures the robust pose graph switched off.
+    pub rejected_loop_closures: Vec<LoopClosure>,
+    /// The final pose graph.
+    pub graph: PoseGraph,
+    /// Timings and counters.
+    pub stats: SlamStats,
+}
+
+impl SlamOutput {
+    /// The trajectory as TUM lines (`t x y z qx qy qz qw`, z = 0, a yaw quaternion).
+    pub fn tum(&self) -> String {
+        raypath_reflectivity::export::tum_lines(
+            self.scans
+                .iter()
+                .zip(&self.world_from_sensor)
+                .map(|(s, p)| (s.stamp_secs, *p)),
+        )
+    }
+
+    /// Writes the TUM trajectory to `path`.
+    pub fn write_tum(&self, path: &Path) -> Result<()> {
+        std::fs::write(path, self.tum())
+            .map_err(|e| SlamError::BadInput(format!("{}: cannot write: {e}", path.display())))
+    }
+
+    /// `frames` (the processed frames, in order) with the optimised laser poses: world and
+    /// laser poses replaced, the robot pose moved with the laser (its mounting kept). Written
+    /// with [`raypath_io::convert::write_carmen`] they are a corrected log.
+    pub fn corrected_frames(&self, frames: &[PlanarFrame]) -> Result<Vec<PlanarFrame>> {
+        if frames.len() != self.world_from_sensor.len() {
+            return Err(SlamError::BadInput(format!(
+                "{} frames given for a run of {} scans",
+                frames.len(),
+                self.world_from_sensor.len()
+            )));
+        }
+        Ok(frames
+            .iter()
+            .zip(&self.world_from_sensor)
+            .map(|(f, &pose)| {
+                let robot_from_laser = f.robot_from_laser();
+                PlanarFrame {
+                    world_from_laser: pose,
+                    world_from_robot: pose * robot_from_laser.inverse(),
+                    ..f.clone()
+                }
+            })
+            .collect())
+    }
+
+    /// Writes `frames` with the optimised poses as a CARMEN corrected log.
+    pub fn write_corrected_log(&self, frames: &[PlanarFrame], path: &Path) -> Result<()> {
+        raypath_io::convert::write_carmen(path, &self.corrected_frames(frames)?)?;
+        Ok(())
+    }
+}

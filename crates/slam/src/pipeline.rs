@@ -1,0 +1,311 @@
+//! The SLAM pipeline: front-end → nodes and submaps → loop closure → pose graph.
+
+use std::time::Instant;
+
+use raypath_geometry::Pose2;
+use raypath_io::sequence::PlanarFrame;
+use raypath_reflectivity::{IntensityCorrection, MatcherConfig, ScanPoints};
+
+use crate::config::{SlamConfig, information};
+use crate::error::{Result, SlamError};
+use crate::frontend::{FrontEnd, freeze_all};
+use crate::graph::{Edge, EdgeKind, PoseGraph};
+use crate::loops::{LoopCloser, LoopClosure};
+use crate::output::{ScanPose, SlamOutput, SlamStats};
+use crate::submap::Submap;
+
+/// Online 2-D SLAM over a stream of planar scans (see the crate docs for the pipeline).
+///
+/// Feed scans in time order with [`Slam::process`], then call [`Slam::finish`] for the
+/// optimised trajectory, the submaps and the loop closures.
+#[derive(Debug)]
+pub struct Slam {
+    config: SlamConfig,
+    matcher: MatcherConfig,
+    correction: Option<IntensityCorrection>,
+    frontend: FrontEnd,
+    loops: Option<LoopCloser>,
+    graph: PoseGraph,
+    /// Per node: (scan index, local pose).
+    node_local: Vec<Pose2>,
+    node_scan: Vec<usize>,
+    /// The finished submap each node belongs to (the later one when it is in two).
+    node_submap: Vec<Option<usize>>,
+    submaps: Vec<Submap>,
+    closures: Vec<LoopClosure>,
+    scans: Vec<ScanPose>,
+    points: ScanPoints,
+    nodes_since_optimisation: usize,
+    loops_since_optimisation: usize,
+    travel_at_last_loop: f64,
+    stats: SlamStats,
+}
+
+impl Slam {
+    /// A SLAM run with `config`.
+    pub fn new(config: SlamConfig) -> Result<Self> {
+        config.validate()?;
+        let loops = match &config.loops {
+            Some(l) => Some(LoopCloser::new(*l, config.filter.max_range_m)?),
+            None => None,
+        };
+        Ok(Self {
+            matcher: config.matcher,
+            frontend: FrontEnd::new(&config),
+            loops,
+            config,
+            correction: None,
+            graph: PoseGraph::new(),
+            node_local: Vec::new(),
+            node_scan: Vec::new(),
+            node_submap: Vec::new(),
+            submaps: Vec::new(),
+            closures: Vec::new(),
+            scans: Vec::new(),
+            points: ScanPoints::new(),
+            nodes_since_optimisation: 0,
+            loops_since_optimisation: 0,
+            travel_at_last_loop: 0.0,
+            stats: SlamStats::default(),
+        })
+    }
+
+    /// Turns intensities into relative reflectivity with `correction` (for the reflectivity
+    /// and combined residuals; Khan 2017 §3.3).
+    pub fn with_correction(mut self, correction: IntensityCorrection) -> Self {
+        self.correction = Some(correction);
+        self
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &SlamConfig {
+        &self.config
+    }
+
+    /// Number of scans processed.
+    pub fn scans(&self) -> usize {
+        self.scans.len()
+    }
+
+    /// Number of nodes so far.
+    pub fn nodes(&self) -> usize {
+        self.node_local.len()
+    }
+
+    /// The current estimate of the latest scan's `world_from_sensor`.
+    pub fn pose(&self) -> Option<Pose2> {
+        self.scans.last().map(|s| self.world_from_local() * s.local)
+    }
+
+    /// Processes one frame: its scan, and its logged `world_from_laser` as odometry when
+    /// [`SlamConfig::use_odometry`] is set.
+    pub fn process(&mut self, frame: &PlanarFrame) -> Result<()> {
+        let odometry = self
+            .config
+            .use_odometry
+            .then_some(frame.world_from_laser)
+            .filter(Pose2::is_finite);
+        self.process_scan(frame.stamp_secs, &frame.scan, odometry)
+    }
+
+    /// Processes one scan taken at `stamp_secs` with the odometry pose `odometry`
+    /// (`world_from_sensor` in the odometry frame; `None`: no odometry).
+    pub fn process_scan(
+        &mut self,
+        stamp_secs: f64,
+        scan: &raypath_geometry::Scan2,
+        odometry: Option<Pose2>,
+    ) -> Result<()> {
+        if !stamp_secs.is_finite() {
+            return Err(SlamError::BadInput(format!(
+                "scan {}: time stamp {stamp_secs} is not finite",
+                self.scans.len()
+            )));
+        }
+        let t0 = Instant::now();
+        self.points
+            .fill_from_scan(scan, &self.config.filter, self.correction.as_ref());
+        let (local, _) = self.frontend.track(&self.points, odometry);
+        let node = if self.frontend.wants_node(&self.config) {
+            Some(self.add_node(stamp_secs, local)?)
+        } else {
+            None
+        };
+        self.scans.push(ScanPose {
+            stamp_secs,
+            local,
+            node: self.node_local.len().saturating_sub(1),
+            is_node: node.is_some(),
+        });
+        self.stats.frontend_seconds += t0.elapsed().as_secs_f64();
+        if let Some(node) = node {
+            self.close_loops(node, scan);
+            self.nodes_since_optimisation += 1;
+            if self.nodes_since_optimisation >= self.config.optimize_every_nodes
+                && self.loops_since_optimisation > 0
+            {
+                self.optimise()?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The map from the front-end's local frame to the optimised world frame (through the
+    /// latest node).
+    fn world_from_local(&self) -> Pose2 {
+        match (self.graph.nodes().last(), self.node_local.last()) {
+            (Some(world), Some(local)) => *world * local.inverse(),
+            _ => Pose2::identity(),
+        }
+    }
+
+    fn add_node(&mut self, _stamp_secs: f64, local: Pose2) -> Result<usize> {
+        let world = self.world_from_local() * local;
+        let node = self.graph.add_node(world);
+        if let Some(&prev) = self.node_local.last() {
+            self.graph.add_edge(Edge {
+                from: node - 1,
+                to: node,
+                measurement: prev.inverse() * local,
+                information: information(&self.config.sequential_sigma),
+                kind: EdgeKind::Sequential,
+            })?;
+        }
+        self.node_local.push(local);
+        self.node_scan.push(self.scans.len());
+        self.node_submap.push(None);
+        let mut intra = Vec::with_capacity(2);
+        let finished = self
+            .frontend
+            .insert(&self.config, node, &self.points, &mut intra)?;
+        if self.config.intra_submap_edges {
+            for (anchor, submap_from_sensor) in intra {
+                self.graph.add_edge(Edge {
+                    from: anchor,
+                    to: node,
+                    measurement: submap_from_sensor,
+                    information: information(&self.config.sequential_sigma),
+                    kind: EdgeKind::Sequential,
+                })?;
+            }
+        }
+        let depth = self.config.loops.map_or(1, |l| l.correlative.depth);
+        for submap in freeze_all(finished, depth) {
+            let k = self.submaps.len();
+            for &n in submap.nodes() {
+                if let Some(slot) = self.node_submap.get_mut(n) {
+                    *slot = Some(k);
+                }
+            }
+            self.submaps.push(submap);
+        }
+        Ok(node)
+    }
+
+    fn close_loops(&mut self, node: usize, scan: &raypath_geometry::Scan2) {
+        let Some(loops) = self.loops.as_mut() else {
+            return;
+        };
+        let t0 = Instant::now();
+        loops.describe(node, scan);
+        let every = self.config.loops.map_or(1, |l| l.every_nodes);
+        if node % every != 0 {
+            self.stats.loop_seconds += t0.elapsed().as_secs_f64();
+            return;
+        }
+        let travel = self.frontend.travel_m() - self.travel_at_last_loop;
+        let found = loops.search(
+            node,
+            &self.points,
+            self.graph.nodes(),
+            &self.node_submap,
+            &self.submaps,
+            &self.matcher,
+            travel,
+        );
+        for (submap, submap_from_sensor, score, source) in found {
+            let Some(anchor) = self.submaps.get(submap).map(Submap::anchor) else {
+                continue;
+            };
+            let edge = Edge {
+                from: anchor,
+                to: node,
+                measurement: submap_from_sensor,
+                information: information(&self.config.loop_sigma),
+                kind: EdgeKind::Loop,
+            };
+            if let Ok(edge) = self.graph.add_edge(edge) {
+                self.closures.push(LoopClosure {
+                    node,
+                    submap,
+                    anchor,
+                    submap_from_sensor,
+                    score,
+                    source,
+                    edge,
+                });
+                self.loops_since_optimisation += 1;
+                self.travel_at_last_loop = self.frontend.travel_m();
+            }
+        }
+        self.stats.loop_seconds += t0.elapsed().as_secs_f64();
+    }
+
+    fn optimise(&mut self) -> Result<()> {
+        let t0 = Instant::now();
+        let report = self.graph.optimize(&self.config.solver)?;
+        self.stats.optimisations += 1;
+        self.stats.final_chi2 = report.final_chi2;
+        self.nodes_since_optimisation = 0;
+        self.loops_since_optimisation = 0;
+        self.stats.optimise_seconds += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Finishes the run: freezes the active submaps, optimises once more and returns the
+    /// trajectory of every scan in the optimised world frame.
+    pub fn finish(mut self) -> Result<SlamOutput> {
+        let depth = self.config.loops.map_or(1, |l| l.correlative.depth);
+        let last = self.frontend.finish();
+        for submap in freeze_all(last, depth) {
+            self.submaps.push(submap);
+        }
+        if self.graph.nodes().len() > 1 {
+            self.optimise()?;
+        }
+        let loop_stats = self.loops.as_ref().map(|l| l.stats).unwrap_or_default();
+        let mut accepted = Vec::new();
+        let mut rejected = Vec::new();
+        for c in self.closures {
+            if self.graph.edge_weight(c.edge) >= self.config.reject_weight {
+                accepted.push(c);
+            } else {
+                rejected.push(c);
+            }
+        }
+        let nodes = self.graph.nodes().to_vec();
+        let world_from_sensor = self
+            .scans
+            .iter()
+            .map(|s| match (nodes.get(s.node), self.node_local.get(s.node)) {
+                (Some(world), Some(local)) => *world * local.inverse() * s.local,
+                _ => s.local,
+            })
+            .collect();
+        let stats = SlamStats {
+            loops: loop_stats,
+            ..self.stats
+        };
+        Ok(SlamOutput {
+            scans: self.scans,
+            world_from_sensor,
+            nodes,
+            node_scan: self.node_scan,
+            submaps: self.submaps,
+            loop_closures: accepted,
+            rejected_loop_closures: rejected,
+            graph: self.graph,
+            stats,
+        })
+    }
+}

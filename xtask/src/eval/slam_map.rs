@@ -1,0 +1,70 @@
+//! The map picture of `cargo xtask eval slam`: the finished submaps' finest levels painted at
+//! their optimised poses (grey unknown, white free, black occupied; later submaps over
+//! earlier ones where both are confident).
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use raypath_slam::SlamOutput;
+
+/// Pixel size of the picture, metres.
+const PIXEL_M: f64 = 0.1;
+/// Largest picture side, pixels.
+const MAX_SIDE: usize = 4000;
+
+/// Writes the map of `out` as a PNG.
+pub fn write_png(out: &SlamOutput, path: &Path) -> Result<()> {
+    // World positions of every submap's observed cells (log-odds, world x, world y).
+    let mut cells: Vec<(f32, f64, f64)> = Vec::new();
+    for s in &out.submaps {
+        let (Some(pose), Some(level)) = (out.nodes.get(s.anchor()), s.levels().first()) else {
+            continue;
+        };
+        let (res, o) = (level.resolution_m(), level.origin());
+        for j in (0..level.height()).step_by(2) {
+            for i in (0..level.width()).step_by(2) {
+                let l = level.log_odds(i, j);
+                if l == 0.0 {
+                    continue;
+                }
+                let p = *pose
+                    * nalgebra::Point2::new(
+                        o[0] + (i as f64 + 0.5) * res,
+                        o[1] + (j as f64 + 0.5) * res,
+                    );
+                cells.push((l, p.x, p.y));
+            }
+        }
+    }
+    let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
+    for &(_, x, y) in &cells {
+        x0 = x0.min(x);
+        y0 = y0.min(y);
+        x1 = x1.max(x);
+        y1 = y1.max(y);
+    }
+    if cells.is_empty() {
+        (x0, y0, x1, y1) = (0.0, 0.0, 1.0, 1.0);
+    }
+    let w = (((x1 - x0) / PIXEL_M) as usize + 1).min(MAX_SIDE);
+    let h = (((y1 - y0) / PIXEL_M) as usize + 1).min(MAX_SIDE);
+    // Sum of clamped log-odds per pixel.
+    let mut sum = vec![0f32; w * h];
+    for &(l, x, y) in &cells {
+        let i = (((x - x0) / PIXEL_M) as usize).min(w - 1);
+        let j = (((y1 - y) / PIXEL_M) as usize).min(h - 1);
+        sum[j * w + i] += l.clamp(-2.0, 4.0);
+    }
+    let img = image::GrayImage::from_fn(w as u32, h as u32, |i, j| {
+        let v = sum[j as usize * w + i as usize];
+        image::Luma([if v > 1.0 {
+            0
+        } else if v < -0.5 {
+            255
+        } else {
+            200
+        }])
+    });
+    img.save(path)
+        .with_context(|| format!("writing {}", path.display()))
+}
