@@ -203,6 +203,16 @@ fn apply_step(nodes: &mut [Pose2], s: &Structure) {
     }
 }
 
+/// A step whose largest component is below this (metres, radians) ends the iterations:
+/// near an exactly consistent graph the cost tends to 0 and its relative decrease stays large
+/// (the step test of Madsen, Nielsen & Tingleff 2004, Sec. 3.2, with an absolute tolerance).
+const STEP_TOLERANCE: f64 = 1e-10;
+
+/// The largest component of the last step Δ.
+fn step_norm(s: &Structure) -> f64 {
+    s.delta.iter().fold(0.0, |m, d| m.max(d.abs()))
+}
+
 /// The outcome of the iterations: (iterations, converged).
 pub(super) type Outcome = (usize, bool);
 
@@ -234,7 +244,10 @@ pub(super) fn run(
         match new_cost {
             // No damped step lowers the cost: a minimum to working precision.
             None => return Ok((iteration + 1, true)),
-            Some(new_cost) if (cost - new_cost).abs() <= config.tolerance * cost => {
+            Some(new_cost)
+                if (cost - new_cost).abs() <= config.tolerance * cost
+                    || step_norm(s) <= STEP_TOLERANCE =>
+            {
                 return Ok((iteration + 1, true));
             }
             Some(_) => {}

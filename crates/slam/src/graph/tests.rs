@@ -485,6 +485,7 @@ fn wrong_loop_edge_is_down_weighted() {
             "seed {seed}: rms {naive_error} vs clean {clean_error}"
         );
         for kernel in [
+            SolverConfig::default().loop_kernel,
             RobustKernel::Dcs { phi: 1.0 },
             RobustKernel::Cauchy { c: 1.0 },
         ] {

@@ -1,0 +1,181 @@
+//! A simulated ring corridor driven twice with drifting odometry: loop closure pulls the
+//! trajectory back to the truth, and every accepted loop closure agrees with the truth.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // test code: a panic is the failure report
+
+use raypath_geometry::{Pose2, Scan2};
+use raypath_slam::benchmark::loop_error;
+use raypath_slam::{Slam, SlamConfig, SlamOutput};
+
+type Segment = ([f64; 2], [f64; 2]);
+
+/// A 24 m × 14 m block of corridors 2 m wide around a 20 m × 10 m inner block, with a few
+/// doorway stubs so that the corridors are not perfectly self-similar.
+fn walls() -> Vec<Segment> {
+    let rect = |x0: f64, y0: f64, x1: f64, y1: f64| {
+        vec![
+            ([x0, y0], [x1, y0]),
+            ([x1, y0], [x1, y1]),
+            ([x1, y1], [x0, y1]),
+            ([x0, y1], [x0, y0]),
+        ]
+    };
+    let mut w = rect(-12.0, -7.0, 12.0, 7.0);
+    w.extend(rect(-10.0, -5.0, 10.0, 5.0));
+    for (x, y, dx, dy) in [
+        (-6.0, 7.0, 0.0, -0.6),
+        (3.0, 7.0, 0.0, -0.4),
+        (12.0, 1.0, -0.5, 0.0),
+        (5.0, -7.0, 0.0, 0.7),
+        (-4.0, -7.0, 0.0, 0.3),
+        (-12.0, -2.0, 0.6, 0.0),
+    ] {
+        w.push(([x, y], [x + dx, y + dy]));
+    }
+    w
+}
+
+fn scan_at(pose: Pose2, walls: &[Segment]) -> Scan2 {
+    let n = 360;
+    let inc = std::f64::consts::TAU / n as f64;
+    let ranges = (0..n)
+        .map(|k| {
+            let a = pose.theta() + k as f64 * inc;
+            let d = [a.cos(), a.sin()];
+            walls
+                .iter()
+                .filter_map(|(p, q)| {
+                    let e = [q[0] - p[0], q[1] - p[1]];
+                    let den = d[0] * e[1] - d[1] * e[0];
+                    let w = [p[0] - pose.x(), p[1] - pose.y()];
+                    let t = (w[0] * e[1] - w[1] * e[0]) / den;
+                    let s = (w[0] * d[1] - w[1] * d[0]) / den;
+                    (den.abs() > 1e-12 && t > 0.0 && (0.0..=1.0).contains(&s)).then_some(t)
+                })
+                .fold(30.0, f64::min)
+        })
+        .collect();
+    Scan2 {
+        angle_min_rad: 0.0,
+        angle_increment_rad: inc,
+        max_range_m: 30.0,
+        ranges,
+        intensities: None,
+    }
+}
+
+/// Poses along the corridors' centre line (a 22 m × 12 m rectangle), `laps` times, 0.1 m apart,
+/// turning on the spot at the corners.
+fn path(laps: usize) -> Vec<Pose2> {
+    let corners: [[f64; 2]; 4] = [[-11.0, -6.0], [11.0, -6.0], [11.0, 6.0], [-11.0, 6.0]];
+    let mut out = Vec::new();
+    for _ in 0..laps {
+        for k in 0..4 {
+            let (a, b) = (corners[k], corners[(k + 1) % 4]);
+            let heading = (b[1] - a[1]).atan2(b[0] - a[0]);
+            let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+            let steps = (len / 0.1).round() as usize;
+            for s in 0..steps {
+                let t = s as f64 / steps as f64;
+                out.push(Pose2::new(
+                    a[0] + t * (b[0] - a[0]),
+                    a[1] + t * (b[1] - a[1]),
+                    heading,
+                ));
+            }
+            for s in 1..=8 {
+                out.push(Pose2::new(
+                    b[0],
+                    b[1],
+                    heading + s as f64 * std::f64::consts::FRAC_PI_2 / 8.0,
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// Odometry with a heading bias of `bias` per radian turned and 1 % too long steps.
+fn odometry(truth: &[Pose2], bias: f64) -> Vec<Pose2> {
+    let mut odo = vec![truth[0]];
+    for w in truth.windows(2) {
+        let d = w[0].inverse() * w[1];
+        let noisy = Pose2::new(1.01 * d.x(), 1.01 * d.y(), d.theta() * (1.0 + bias) + 0.002);
+        let last = *odo.last().unwrap();
+        odo.push(last * noisy);
+    }
+    odo
+}
+
+fn run(config: SlamConfig, truth: &[Pose2], odo: &[Pose2]) -> SlamOutput {
+    let walls = walls();
+    let mut slam = Slam::new(config).unwrap();
+    for (k, (p, o)) in truth.iter().zip(odo).enumerate() {
+        slam.process_scan(k as f64 * 0.05, &scan_at(*p, &walls), Some(*o))
+            .unwrap();
+    }
+    slam.finish().unwrap()
+}
+
+/// Largest position error after expressing both trajectories relative to their first pose.
+fn max_error(truth: &[Pose2], estimate: &[Pose2]) -> f64 {
+    truth
+        .iter()
+        .zip(estimate)
+        .map(|(t, e)| {
+            let a = truth[0].inverse() * *t;
+            let b = estimate[0].inverse() * *e;
+            (a.translation() - b.translation()).norm()
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn a_simulated_loop_is_closed_and_no_wrong_loop_is_accepted() {
+    let truth = path(2);
+    let odo = odometry(&truth, 0.03);
+    let full = run(SlamConfig::default(), &truth, &odo);
+    let open = run(
+        SlamConfig {
+            loops: None,
+            ..SlamConfig::default()
+        },
+        &truth,
+        &odo,
+    );
+    let e_full = max_error(&truth, &full.world_from_sensor);
+    let e_open = max_error(&truth, &open.world_from_sensor);
+    let e_odo = max_error(&truth, &odo);
+    assert!(!full.loop_closures.is_empty(), "no loop closure accepted");
+    assert!(e_full < 0.25, "with loop closure: {e_full} m");
+    assert!(e_full < e_open, "loops {e_full} m, no loops {e_open} m");
+    assert!(e_open < e_odo, "front-end {e_open} m, odometry {e_odo} m");
+    // Every accepted loop closure agrees with the truth (scan poses relative to the first).
+    let world = |k: usize| truth[0].inverse() * truth[k];
+    for c in &full.loop_closures {
+        let (a, b) = (full.node_scan[c.anchor], full.node_scan[c.node]);
+        let (t, r) = loop_error(Some(world(a)), Some(world(b)), c.submap_from_sensor).unwrap();
+        assert!(t < 0.15 && r < 0.03, "loop {a} → {b}: {t} m, {r} rad");
+    }
+}
+
+#[test]
+fn bad_scans_are_errors_not_panics() {
+    let mut slam = Slam::new(SlamConfig::default()).unwrap();
+    let mut scan = scan_at(Pose2::identity(), &walls());
+    assert!(slam.process_scan(f64::NAN, &scan, None).is_err());
+    scan.ranges.iter_mut().for_each(|r| *r = f64::NAN);
+    slam.process_scan(0.0, &scan, None).unwrap();
+    scan.ranges.clear();
+    slam.process_scan(0.1, &scan, Some(Pose2::new(f64::NAN, 0.0, 0.0)))
+        .unwrap();
+    let out = slam.finish().unwrap();
+    assert_eq!(out.scans.len(), 2);
+    assert!(out.world_from_sensor.iter().all(|p| p.is_finite()));
+    assert!(
+        Slam::new(SlamConfig {
+            optimize_every_nodes: 0,
+            ..SlamConfig::default()
+        })
+        .is_err()
+    );
+}
