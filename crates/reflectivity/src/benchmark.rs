@@ -209,14 +209,26 @@ pub fn relative_errors(
         ) else {
             continue;
         };
-        let e = (gi.inverse() * *gj).inverse() * (ei.inverse() * *ej);
-        t.push(e.translation().norm());
-        r.push(wrap_angle(e.theta()));
+        let (dt, dr) = relation_error(gi, gj, ei, ej);
+        t.push(dt);
+        r.push(dr);
     }
     RelativeErrors {
         translation_m: Stats::of(t),
         rotation_rad: Stats::of(r),
     }
+}
+
+/// The error of one relation `(i, j)` (Kümmerle et al. 2009): the pose `δ_ref⁻¹ δ_est` with
+/// `δ = x_i⁻¹ x_j`, as its translation length (m) and its wrapped angle (rad, signed).
+pub fn relation_error(
+    reference_i: &Pose2,
+    reference_j: &Pose2,
+    estimate_i: &Pose2,
+    estimate_j: &Pose2,
+) -> (f64, f64) {
+    let e = (reference_i.inverse() * *reference_j).inverse() * (estimate_i.inverse() * *estimate_j);
+    (e.translation().norm(), wrap_angle(e.theta()))
 }
 
 /// Relations between consecutive poses: `(k, k + 1)`.

@@ -13,7 +13,8 @@
 //!
 //! The relation set is written into every report so the numbers can be reproduced.
 
-use raypath_geometry::{Pose2, wrap_angle};
+use raypath_geometry::Pose2;
+use raypath_reflectivity::benchmark::{Stats, relation_error};
 use serde::Serialize;
 
 /// Mean and standard deviation of the relation errors: the JSON keys are a contract of
@@ -79,29 +80,19 @@ pub fn relation_errors(
         ) else {
             continue;
         };
-        let e = (gi.inverse() * *gj).inverse() * (ei.inverse() * *ej);
-        t.push(e.translation().norm());
-        r.push(wrap_angle(e.theta()).abs().to_degrees());
+        let (dt, dr) = relation_error(gi, gj, ei, ej);
+        t.push(dt);
+        r.push(dr.abs().to_degrees());
     }
-    let (tm, ts) = mean_std(&t);
-    let (rm, rs) = mean_std(&r);
+    let (t, r) = (Stats::of(t), Stats::of(r));
+    let nan_if_empty = |v: f64| if t.count == 0 { f64::NAN } else { v };
     ErrorSummary {
-        trans_error_m: tm,
-        trans_error_std_m: ts,
-        rot_error_deg: rm,
-        rot_error_std_deg: rs,
-        relations: t.len(),
+        trans_error_m: nan_if_empty(t.mean),
+        trans_error_std_m: nan_if_empty(t.std),
+        rot_error_deg: nan_if_empty(r.mean),
+        rot_error_std_deg: nan_if_empty(r.std),
+        relations: t.count,
     }
-}
-
-fn mean_std(v: &[f64]) -> (f64, f64) {
-    if v.is_empty() {
-        return (f64::NAN, f64::NAN);
-    }
-    let n = v.len() as f64;
-    let mean = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n;
-    (mean, var.sqrt())
 }
 
 /// Whether a loop closure agrees with the reference: the error of its relative pose between
@@ -113,8 +104,8 @@ pub fn loop_error(
     measured_a_from_b: Pose2,
 ) -> Option<(f64, f64)> {
     let (a, b) = (reference_a?, reference_b?);
-    let e = (a.inverse() * b).inverse() * measured_a_from_b;
-    Some((e.translation().norm(), wrap_angle(e.theta()).abs()))
+    let (t, r) = relation_error(&a, &b, &Pose2::identity(), &measured_a_from_b);
+    Some((t, r.abs()))
 }
 
 /// Self-consistency of a map without reference poses: of the confidently occupied cells of

@@ -171,6 +171,30 @@ impl Recording {
         self.stamped(stamp_secs, result)
     }
 
+    /// Every planar frame at its estimated laser pose (`/tf` `map → base_link` with the
+    /// logged mounting, `/scan` in `base_link`) and the robot's trajectory (`/trajectory`, at
+    /// the end): the track of a 2-D estimate (`scan-match`, `slam`).
+    pub fn planar_track(
+        &mut self,
+        frames: &[raypath_io::sequence::PlanarFrame],
+        world_from_laser: &[Pose2],
+    ) -> Result<(), Failure> {
+        let mut robots = Vec::with_capacity(world_from_laser.len());
+        for (frame, pose) in frames.iter().zip(world_from_laser) {
+            let robot_from_laser = frame.robot_from_laser();
+            let world_from_robot = *pose * robot_from_laser.inverse();
+            self.planar_scan(
+                frame.stamp_secs,
+                &world_from_robot,
+                &robot_from_laser,
+                &frame.scan,
+            )?;
+            robots.push(world_from_robot);
+        }
+        let end = self.end_stamp();
+        self.planar_trajectory(topic::TRAJECTORY, end, &robots)
+    }
+
     /// A 2-D map over `grid` (in `map`, the `z = 0` plane) as `foxglove.Grid`: one field
     /// `field` of `values` in [`Grid2::linear_index`] order.
     pub fn grid(

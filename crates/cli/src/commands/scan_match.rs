@@ -146,26 +146,32 @@ fn config(args: &Args) -> Result<MatcherConfig, Failure> {
     Ok(config)
 }
 
-fn read_lut(args: &Args, mode: ResidualMode) -> Result<Option<IntensityCorrection>, Failure> {
-    let Some(path) = &args.lut else {
+/// The intensity model of `--lut` (JSON from `raypath calibrate-intensity`, validated); an
+/// error when the residual `mode` needs one and none is given. Shared with `raypath slam`.
+pub(crate) fn read_correction(
+    lut: Option<&std::path::Path>,
+    mode: ResidualMode,
+    json: bool,
+) -> Result<Option<IntensityCorrection>, Failure> {
+    let Some(path) = lut else {
         if mode != ResidualMode::Occupancy {
             return Err(Failure::input(
                 format!(
                     "--mode {}: needs --lut (from raypath calibrate-intensity)",
                     mode.name()
                 ),
-                args.json,
+                json,
             ));
         }
         return Ok(None);
     };
     let text = std::fs::read_to_string(path)
-        .map_err(|e| Failure::input(format!("{}: {e}", path.display()), args.json))?;
+        .map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))?;
     let model: IntensityCorrection = serde_json::from_str(&text)
-        .map_err(|e| Failure::input(format!("{}:{}: {e}", path.display(), e.line()), args.json))?;
+        .map_err(|e| Failure::input(format!("{}:{}: {e}", path.display(), e.line()), json))?;
     if let IntensityCorrection::Lut(lut) = &model {
         lut.validate()
-            .map_err(|e| Failure::input(format!("{}: {e}", path.display()), args.json))?;
+            .map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))?;
     }
     Ok(Some(model))
 }
@@ -282,7 +288,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     if !(args.max_range.is_finite() && args.max_range > 0.0) {
         return Err(Failure::input("--max-range: must be positive", args.json));
     }
-    let lut = read_lut(args, config.mode)?;
+    let lut = read_correction(args.lut.as_deref(), config.mode, args.json)?;
     let mut recording = Recording::open(&args.record, args.json)?;
     let mut scans = read_scans(args)?;
     if args.corrected_log.is_some() && carmen_lines(&scans).is_none() {

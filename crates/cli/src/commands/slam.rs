@@ -34,7 +34,7 @@ use std::time::Instant;
 use nalgebra::Point3;
 use raypath_io::foxglove::{frame, topic};
 use raypath_io::sequence::{PlanarFrame, pair_reference};
-use raypath_reflectivity::{IntensityCorrection, ResidualMode};
+use raypath_reflectivity::ResidualMode;
 use raypath_sensor_models::export::{MapFile, StoredStats};
 use raypath_slam::benchmark::{
     consecutive_relations, loop_error, random_relations, reference_by_neighbour, relation_errors,
@@ -147,27 +147,11 @@ fn config(args: &Args) -> Result<SlamConfig, Failure> {
     Ok(config)
 }
 
-fn read_lut(args: &Args) -> Result<Option<IntensityCorrection>, Failure> {
-    let Some(path) = &args.lut else {
-        if args.mode != ModeArg::Occupancy {
-            return Err(Failure::input(
-                "--mode reflectivity/combined: needs --lut (from raypath calibrate-intensity)",
-                args.json,
-            ));
-        }
-        return Ok(None);
-    };
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| Failure::input(format!("{}: {e}", path.display()), args.json))?;
-    serde_json::from_str(&text)
-        .map(Some)
-        .map_err(|e| Failure::input(format!("{}:{}: {e}", path.display(), e.line()), args.json))
-}
-
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let config = config(args)?;
-    let lut = read_lut(args)?;
+    let lut =
+        super::scan_match::read_correction(args.lut.as_deref(), args.mode.residual(), args.json)?;
     let mut recording = Recording::open(&args.record, args.json)?;
     let mut frames = args
         .source
@@ -441,20 +425,8 @@ fn record(
     map_prefix: &Path,
     model: Model,
 ) -> Result<(), Failure> {
-    let mut robots = Vec::with_capacity(frames.len());
-    for (frame, world_from_laser) in frames.iter().zip(&out.world_from_sensor) {
-        let robot_from_laser = frame.robot_from_laser();
-        let world_from_robot = *world_from_laser * robot_from_laser.inverse();
-        recording.planar_scan(
-            frame.stamp_secs,
-            &world_from_robot,
-            &robot_from_laser,
-            &frame.scan,
-        )?;
-        robots.push(world_from_robot);
-    }
+    recording.planar_track(frames, &out.world_from_sensor)?;
     let end = recording.end_stamp();
-    recording.planar_trajectory(topic::TRAJECTORY, end, &robots)?;
     let rpmap = map_prefix.with_extension("rpmap");
     let file = MapFile::read_file(&rpmap).map_err(|e| failure(e, false))?;
     if let StoredStats::Planar(stats) = &file.stats {

@@ -22,20 +22,8 @@ pub fn record(
     poses: &[Pose2],
     level: Option<&GridLevel>,
 ) -> Result<(), Failure> {
-    let mut robots = Vec::with_capacity(poses.len());
-    for (frame, world_from_laser) in scans.iter().zip(poses) {
-        let robot_from_laser = frame.robot_from_laser();
-        let world_from_robot = *world_from_laser * robot_from_laser.inverse();
-        recording.planar_scan(
-            frame.stamp_secs,
-            &world_from_robot,
-            &robot_from_laser,
-            &frame.scan,
-        )?;
-        robots.push(world_from_robot);
-    }
+    recording.planar_track(scans, poses)?;
     let end = recording.end_stamp();
-    recording.planar_trajectory(topic::TRAJECTORY, end, &robots)?;
     let Some(level) = level else {
         return Ok(());
     };
