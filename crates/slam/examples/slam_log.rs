@@ -53,6 +53,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let (Some(e), Some(l)) = (env("SLAM_EVERY"), config.loops.as_mut()) {
         l.every_nodes = e as usize;
     }
+    if let Some(g) = env("SLAM_GAIN") {
+        config.submaps.rotation_min_gain = g;
+    }
     if let Some(w) = env("SLAM_ROT") {
         config.submaps.rotation_window_rad = w;
     }
@@ -117,6 +120,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         odo.theta().to_degrees(),
                         (gi.inverse() * gj).translation().norm(),
                         (gi.inverse() * gj).theta().to_degrees()
+                    );
+                }
+            }
+        }
+        let (checked, wrong, errors) = raypath_slam::benchmark::check_loops(&out, &reference, 50);
+        println!("loop closures: {wrong} of {checked} checked wrong");
+        if std::env::var("SLAM_LOOPS").is_ok() {
+            for (c, (t, r)) in out.loop_closures.iter().zip(&errors) {
+                if *t > 0.15 || r.to_degrees() > 1.5 {
+                    let (a, b) = (out.node_scan[c.anchor], out.node_scan[c.node]);
+                    println!(
+                        "loop {a}->{b} {:?} score {:.3} error {t:.3} m {:.2}°",
+                        c.source,
+                        c.score,
+                        r.to_degrees()
                     );
                 }
             }

@@ -95,9 +95,8 @@ pub fn relation_errors(
     }
 }
 
-/// Whether a loop closure agrees with the reference: the error of its relative pose between
-/// the two scans (reference relative pose vs the constraint) is below `max_translation_m` and
-/// `max_rotation_rad`. `None` when either scan has no reference.
+/// The error of a measured relative pose `a⁻¹ b` against the reference poses of `a` and `b`:
+/// translation (m) and absolute angle (rad); `None` when either reference is missing.
 pub fn loop_error(
     reference_a: Option<Pose2>,
     reference_b: Option<Pose2>,
@@ -106,6 +105,68 @@ pub fn loop_error(
     let (a, b) = (reference_a?, reference_b?);
     let (t, r) = relation_error(&a, &b, &Pose2::identity(), &measured_a_from_b);
     Some((t, r.abs()))
+}
+
+/// A loop closure is wrong when its association error exceeds this, metres …
+pub const WRONG_LOOP_M: f64 = 0.3;
+/// … or this, degrees.
+pub const WRONG_LOOP_DEG: f64 = 3.0;
+
+/// Checks every accepted loop closure of `output` against `reference` (per scan; `None` where
+/// a scan has none): the **association error** of a loop closure is the error of the relative
+/// pose between its node and the submap node nearest to where it was matched (the front-end's
+/// pose of that node in the submap, composed with the loop's `submap_from_sensor`), against
+/// the reference. It says whether the scan was placed at the right spot of the submap; the
+/// anchor-to-node relation would also charge the loop for the submap's own bending over its
+/// length, which the intra-submap constraints carry. Scans without a reference borrow one
+/// from the nearest referenced scan within `max_gap` scans ([`reference_by_neighbour`]).
+/// Returns `(checked, wrong, errors)` with one `(m, rad)` per checked loop closure.
+pub fn check_loops(
+    output: &crate::SlamOutput,
+    reference: &[Option<Pose2>],
+    max_gap: usize,
+) -> (usize, usize, Vec<(f64, f64)>) {
+    let local: Vec<Pose2> = output.scans.iter().map(|s| s.local).collect();
+    let near = reference_by_neighbour(reference, &local, max_gap);
+    let node_local = |n: usize| output.node_scan.get(n).and_then(|&k| local.get(k)).copied();
+    let mut errors = Vec::new();
+    for c in &output.loop_closures {
+        let (Some(submap), Some(anchor_local), Some(&scan)) = (
+            output.submaps.get(c.submap),
+            node_local(c.anchor),
+            output.node_scan.get(c.node),
+        ) else {
+            continue;
+        };
+        // The submap node nearest to the matched position.
+        let Some((k, submap_from_k)) = submap
+            .nodes()
+            .iter()
+            .filter_map(|&k| Some((k, anchor_local.inverse() * node_local(k)?)))
+            .min_by(|a, b| {
+                let d = |p: &Pose2| (p.translation() - c.submap_from_sensor.translation()).norm();
+                d(&a.1).total_cmp(&d(&b.1))
+            })
+        else {
+            continue;
+        };
+        let Some(&k_scan) = output.node_scan.get(k) else {
+            continue;
+        };
+        let measured = submap_from_k.inverse() * c.submap_from_sensor;
+        if let Some(e) = loop_error(
+            near.get(k_scan).copied().flatten(),
+            near.get(scan).copied().flatten(),
+            measured,
+        ) {
+            errors.push(e);
+        }
+    }
+    let wrong = errors
+        .iter()
+        .filter(|(t, r)| *t > WRONG_LOOP_M || r.to_degrees() > WRONG_LOOP_DEG)
+        .count();
+    (errors.len(), wrong, errors)
 }
 
 /// Self-consistency of a map without reference poses: of the confidently occupied cells of

@@ -30,6 +30,7 @@ pub(crate) struct FrontEnd {
     travel_m: f64,
     rotation_window_rad: f64,
     rotation_step_rad: f64,
+    rotation_min_gain: f64,
 }
 
 impl FrontEnd {
@@ -46,6 +47,7 @@ impl FrontEnd {
             travel_m: 0.0,
             rotation_window_rad: config.submaps.rotation_window_rad,
             rotation_step_rad: config.submaps.rotation_step_rad,
+            rotation_min_gain: config.submaps.rotation_min_gain,
         }
     }
 
@@ -76,6 +78,7 @@ impl FrontEnd {
                         initial,
                         self.rotation_window_rad,
                         self.rotation_step_rad,
+                        self.rotation_min_gain,
                     );
                 }
                 let prior = self.matcher.odometry_sigma.map(|s| Prior {
@@ -168,15 +171,17 @@ impl FrontEnd {
 }
 
 /// The heading within `±window` (steps of `step`) around `initial` whose rotated points score
-/// best on the coarsest level (mean bilinear occupancy of every 4th point; position kept): a
-/// correlative search over rotation only, which brings large odometry heading errors into the
-/// Gauss–Newton basin (Olson 2009's idea, restricted to one axis).
+/// best on the coarsest level (mean bilinear occupancy of every 4th point; position kept), when
+/// it beats the guess's score by at least `min_gain`: a correlative search over rotation only,
+/// which brings large odometry heading errors into the Gauss–Newton basin (Olson 2009's idea,
+/// restricted to one axis) and leaves good guesses alone.
 fn rotation_search(
     levels: &[GridLevel],
     points: &ScanPoints,
     initial: Pose2,
     window: f64,
     step: f64,
+    min_gain: f64,
 ) -> Pose2 {
     let Some(grid) = levels.last() else {
         return initial;
@@ -195,7 +200,8 @@ fn rotation_search(
         sum / n.max(1) as f64
     };
     let steps = (window / step).floor() as i64;
-    let mut best = (score(initial.theta()), initial.theta());
+    let at_guess = score(initial.theta());
+    let mut best = (at_guess + min_gain, initial.theta());
     for k in (-steps..=steps).filter(|&k| k != 0) {
         let theta = initial.theta() + k as f64 * step;
         let v = score(theta);

@@ -41,9 +41,10 @@
 //!
 //! * Nodes every 0.25 m or 0.25 rad; 30 nodes per submap (two active, each finished after
 //!   60); finest cell 5 cm, 3 levels (Khan's working point); odometry is the initial guess.
-//! * Before Gauss–Newton, the heading is searched within ±0.2 rad on the coarsest level: the
-//!   odometry of the benchmark logs turns by several degrees more or less than the robot
-//!   between scans, beyond the Gauss–Newton basin at 10 m range.
+//! * Before Gauss–Newton, the heading is searched within ±0.2 rad on the coarsest level and
+//!   kept when it scores clearly better than the guess: the odometry of the benchmark logs
+//!   turns by several degrees more or less than the robot between scans, beyond the
+//!   Gauss–Newton basin at 10 m range.
 //! * Loop search from every third node against the three nearest finished submaps within
 //!   10 m (+ 2 % of the path since the last loop closure), windows ±1.5 m / ±20°, and one
 //!   place-recognition candidate over ±π; minimum branch-and-bound score 0.55 (Hess et al.'s

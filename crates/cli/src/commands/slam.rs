@@ -22,8 +22,8 @@
 //! "relations"}` over the relations between consecutive referenced scans (Kümmerle et al.
 //! 2009; scans paired with the corrected log by identical readings), `"random_pairs"` (the
 //! same over 1000 seeded random pairs) and `"wrong_loop_closures"` (accepted loop closures
-//! off the reference by more than 0.3 m or 3°, among those whose two scans have a reference
-//! or a referenced scan at most 50 scans away, moved by the front-end's relative motion).
+//! whose association error is above 0.3 m or 3°, `raypath_slam::benchmark::check_loops`, of
+//! `"loop_closures_checked"`).
 //!
 //! `--record OUT.mcap`: every scan at its optimised pose (`/tf`, `/scan`), the `/trajectory`,
 //! the rebuilt map as `/map` and the loop closures as lines (`/loops`).
@@ -37,7 +37,7 @@ use raypath_io::sequence::{PlanarFrame, pair_reference};
 use raypath_reflectivity::ResidualMode;
 use raypath_sensor_models::export::{MapFile, StoredStats};
 use raypath_slam::benchmark::{
-    consecutive_relations, loop_error, random_relations, reference_by_neighbour, relation_errors,
+    check_loops, consecutive_relations, random_relations, relation_errors,
 };
 use raypath_slam::{Slam, SlamConfig, SlamOutput};
 use serde_json::{Value, json};
@@ -119,11 +119,6 @@ impl ModeArg {
 /// Loop closures between scans without a reference are checked against the nearest referenced
 /// scan at most this many scans away, moved by the front-end's relative motion.
 const NEIGHBOUR_GAP: usize = 50;
-/// A loop closure is "wrong" when its relative pose is off the reference by more than this.
-const WRONG_LOOP_M: f64 = 0.3;
-/// … or this many degrees.
-const WRONG_LOOP_DEG: f64 = 3.0;
-
 fn failure(message: impl std::fmt::Display, json: bool) -> Failure {
     Failure {
         message: message.to_string(),
@@ -307,20 +302,7 @@ fn evaluate(
         &out.world_from_sensor,
         &random_relations(&referenced, 1000, 1),
     );
-    let local: Vec<_> = out.scans.iter().map(|s| s.local).collect();
-    let truth = reference_by_neighbour(&truth, &local, NEIGHBOUR_GAP);
-    let (mut checked, mut wrong) = (0, 0);
-    for c in &out.loop_closures {
-        let (Some(&a), Some(&b)) = (out.node_scan.get(c.anchor), out.node_scan.get(c.node)) else {
-            continue;
-        };
-        if let Some((t, r)) = loop_error(truth[a], truth[b], c.submap_from_sensor) {
-            checked += 1;
-            if t > WRONG_LOOP_M || r.to_degrees() > WRONG_LOOP_DEG {
-                wrong += 1;
-            }
-        }
-    }
+    let (checked, wrong, _) = check_loops(out, &truth, NEIGHBOUR_GAP);
     Ok(json!({
         "paired_scans": paired,
         "summary": summary,
