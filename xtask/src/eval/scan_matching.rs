@@ -370,6 +370,16 @@ fn quantile(v: &mut [f64], q: f64) -> f64 {
     v.get(k).copied().unwrap_or(f64::NAN)
 }
 
+/// The intensity LUT fitted to `n` reference-surface samples of the simulator's intensity
+/// model (the calibration of this evaluation), for other evaluations on the generated worlds.
+pub(super) fn simulated_lut(n: usize) -> Result<IntensityCorrection> {
+    let reference = sim::reference_samples(&IntensityModel::default(), n, SEED);
+    Ok(IntensityCorrection::Lut(IntensityLut::fit(
+        &reference,
+        &LutConfig::default(),
+    )?))
+}
+
 fn run_calibration(ctx: &EvalContext, md: &mut String) -> Result<(Value, IntensityCorrection)> {
     let model = IntensityModel::default();
     let (n_ref, n_surface) = if ctx.quick {
