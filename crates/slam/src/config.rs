@@ -32,10 +32,10 @@ pub struct SubmapConfig {
     /// Step of that search, radians. Default 1°.
     pub rotation_step_rad: f64,
     /// The searched heading replaces the guess only when its score (mean occupancy probability
-    /// of the points on the coarsest level) is higher by at least this. Default 0.03: on the
-    /// Intel log an unconditional search (0) raises the relation error's spread (0.023 →
-    /// 0.047 m), 0.1 leaves mit-csail's large turns uncorrected (0.037 → 0.078 m); 0.03 keeps
-    /// both near their best (ours, measured with the `slam_log` example).
+    /// of the points on the coarsest level) is higher by at least this. Default 0.03 (ours):
+    /// an unconditional search (0) adds outliers to the Intel relations, a high threshold
+    /// (0.1) leaves mit-csail's large turns uncorrected; 0.03 kept both near their best in our
+    /// runs of the `slam_log` example on the benchmark logs.
     pub rotation_min_gain: f64,
     /// Side of the square grid of one active submap, metres, centred on its first node. It
     /// must hold the points of every scan of the submap: at least twice the maximum range.
