@@ -398,7 +398,16 @@ fn residual_ablation(ctx: &EvalContext, md: &mut String) -> Result<Vec<Value>> {
             frames.truncate(600);
         }
         pair_reference(&mut frames, &read_planar(&corrected, &options)?);
-        for mode in [ResidualMode::Occupancy, ResidualMode::Combined] {
+        let modes: &[ResidualMode] = if frames.iter().any(|f| f.scan.intensities.is_some()) {
+            &[ResidualMode::Occupancy, ResidualMode::Combined]
+        } else {
+            let _ = writeln!(
+                md,
+                "* `indoor/{world}` has no remissions (FLASER lines): occupancy only.\n"
+            );
+            &[ResidualMode::Occupancy]
+        };
+        for &mode in modes {
             let mut config = SlamConfig::default();
             config.matcher.mode = mode;
             let started = Instant::now();
