@@ -106,7 +106,7 @@ pub fn render_text(path: &std::path::Path, s: &Summary) -> String {
         );
     }
     for (key, value) in &s.extra {
-        if key != "topics" {
+        if key != "topics" && key != "semantic_classes" {
             push(&key.replace('_', " "), render_value(value));
         }
     }
@@ -122,6 +122,31 @@ pub fn render_text(path: &std::path::Path, s: &Summary) -> String {
         .collect();
     if let Some(serde_json::Value::Array(topics)) = s.extra.get("topics") {
         text.push_str(&render_topics(topics));
+    }
+    if let Some(classes) = s.extra.get("semantic_classes") {
+        text.push_str(&render_classes(classes));
+    }
+    text
+}
+
+/// SemanticKITTI label counts as a table: class id, name, points, share, instances.
+fn render_classes(classes: &serde_json::Value) -> String {
+    let rows = classes["classes"].as_array().map_or(&[][..], Vec::as_slice);
+    let total: u64 = rows.iter().filter_map(|r| r["points"].as_u64()).sum();
+    let mut text = format!(
+        "semantic labels ({} labelled frames):\n  {:>5}  {:<22} {:>10} {:>7} {:>9}\n",
+        classes["frames"], "class", "name", "points", "share", "instances"
+    );
+    for r in rows {
+        let points = r["points"].as_u64().unwrap_or(0);
+        text.push_str(&format!(
+            "  {:>5}  {:<22} {:>10} {:>6.2}% {:>9}\n",
+            r["class"],
+            r["name"].as_str().unwrap_or(""),
+            points,
+            100.0 * points as f64 / total.max(1) as f64,
+            r["instances"]
+        ));
     }
     text
 }

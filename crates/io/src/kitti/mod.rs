@@ -9,6 +9,7 @@
 //! dataset/sequences/XX/times.txt             one timestamp a line, seconds since the start
 //! dataset/sequences/XX/calib.txt             P0: … P3: (3×4 projections), Tr: (3×4 velo → cam0)
 //! dataset/poses/XX.txt                       12 numbers a line: row-major 3×4 [R | t]
+//! dataset/sequences/XX/labels/NNNNNN.label    SemanticKITTI: N × u32, class | instance << 16
 //! ```
 //!
 //! Frames:
@@ -29,6 +30,7 @@
 //! [`PointCloud::intensity`]: raypath_geometry::PointCloud::intensity
 
 mod calib;
+mod labels;
 mod poses;
 mod sequence;
 mod velodyne;
@@ -42,6 +44,10 @@ use crate::summary::{BoundingBox, Summary, TimeSpan};
 use crate::{Error, Format, Location, Result};
 
 pub use calib::{KittiCalib, parse_calib, read_calib};
+pub use labels::{
+    ClassCount, LABEL_BYTES, PointLabel, check_label_count, count_classes, parse_labels, read_labels,
+    semantic_class_name,
+};
 pub use poses::{
     flu_from_camera, parse_poses, parse_times, read_poses, read_times, velodyne_poses,
 };
@@ -162,7 +168,44 @@ fn summarize_sequence(path: &Path, mut summary: Summary) -> Result<Summary> {
     if let Some(name) = &sequence.name {
         summary = summary.with_extra("sequence", name.clone());
     }
+    if let Some(classes) = label_classes(&sequence)? {
+        summary = summary.with_extra("semantic_classes", classes);
+    }
     Ok(summary)
+}
+
+/// Points and instances per SemanticKITTI class over the labelled frames of a sequence, as
+/// the `semantic_classes` entry of `raypath info`: `[{class, name, points, instances}]`
+/// (instances counted per frame and summed). `None` when no frame has labels.
+fn label_classes(sequence: &KittiSequence) -> Result<Option<serde_json::Value>> {
+    let mut totals: std::collections::BTreeMap<u16, ClassCount> = Default::default();
+    let mut labelled = 0usize;
+    for scan in &sequence.scan_files {
+        let Some(labels) = sequence.labels(scan.frame)? else {
+            continue;
+        };
+        labelled += 1;
+        for (class, count) in count_classes(&labels) {
+            let total = totals.entry(class).or_default();
+            total.points += count.points;
+            total.instances += count.instances;
+        }
+    }
+    if labelled == 0 {
+        return Ok(None);
+    }
+    let rows: Vec<serde_json::Value> = totals
+        .into_iter()
+        .map(|(class, count)| {
+            serde_json::json!({
+                "class": class,
+                "name": semantic_class_name(class).unwrap_or("unknown"),
+                "points": count.points,
+                "instances": count.instances,
+            })
+        })
+        .collect();
+    Ok(Some(serde_json::json!({ "frames": labelled, "classes": rows })))
 }
 
 /// Reads the next line of `lines` into `buf` (reused, so no allocation per line), for parsers

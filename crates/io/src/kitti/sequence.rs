@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use raypath_geometry::{PointCloud, Pose3};
 
 use super::calib::{KittiCalib, read_calib};
+use super::labels::{PointLabel, check_label_count, read_labels};
 use super::poses::{read_poses, read_times};
 use super::velodyne::{read_velodyne, velodyne_point_count};
 use crate::{Error, Location, Result};
@@ -129,11 +130,34 @@ impl KittiSequence {
 
     /// The scan of frame `frame`, `None` when there is no such file.
     pub fn scan(&self, frame: u64) -> Option<Result<PointCloud>> {
+        self.scan_file(frame).map(|f| read_velodyne(&f.path))
+    }
+
+    /// The SemanticKITTI labels of frame `frame` (`labels/NNNNNN.label` beside `velodyne/`),
+    /// `None` when the sequence has no label file for it. One label per point of the scan,
+    /// in the same order (checked against the scan file's size).
+    pub fn labels(&self, frame: u64) -> Result<Option<Vec<PointLabel>>> {
+        let Some(path) = self.labels_path(frame) else {
+            return Ok(None);
+        };
+        let labels = read_labels(&path)?;
+        if let Some(scan) = self.scan_file(frame) {
+            check_label_count(&labels, velodyne_point_count(&scan.path)? as usize, &path)?;
+        }
+        Ok(Some(labels))
+    }
+
+    /// The label file of frame `frame`, when it exists.
+    pub fn labels_path(&self, frame: u64) -> Option<PathBuf> {
+        let path = self.dir.join("labels").join(format!("{frame:06}.label"));
+        path.is_file().then_some(path)
+    }
+
+    fn scan_file(&self, frame: u64) -> Option<&ScanFile> {
         self.scan_files
             .binary_search_by_key(&frame, |f| f.frame)
             .ok()
             .and_then(|i| self.scan_files.get(i))
-            .map(|f| read_velodyne(&f.path))
     }
 
     /// Total number of points of all scans, from the file sizes (nothing is parsed).
