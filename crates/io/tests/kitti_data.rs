@@ -41,6 +41,40 @@ fn pole_sequences_have_one_time_per_pose() {
 }
 
 #[test]
+fn real_frames_have_one_semantic_label_per_point() {
+    let Some(root) = require("kitti/sequences") else {
+        return;
+    };
+    for seq in ["00", "01", "04", "07"] {
+        let sequence = KittiSequence::open(&root.join(seq)).unwrap();
+        assert_eq!(sequence.scan_files.len(), 10, "sequence {seq}");
+        let mut poles = 0;
+        for scan in sequence.scans() {
+            let scan = scan.unwrap();
+            let labels = sequence.labels(scan.frame).unwrap().unwrap();
+            assert_eq!(labels.len(), scan.points.len());
+            let counts = kitti::count_classes(&labels);
+            // Every class is one SemanticKITTI defines; roads and poles are there.
+            assert!(counts.keys().all(|&c| kitti::semantic_class_name(c).is_some()));
+            assert!(counts[&40].points > 10_000, "sequence {seq}: road");
+            poles += counts.get(&80).map_or(0, |c| c.points);
+        }
+        // The data README: ≈ 600–720 pole points per frame.
+        assert!((4000..9000).contains(&poles), "sequence {seq}: {poles} pole points");
+    }
+    let summary = raypath_io::summarize(&root.join("00")).unwrap();
+    let classes = &summary.extra["semantic_classes"];
+    assert_eq!(classes["frames"], 10);
+    let pole = classes["classes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["class"] == 80)
+        .unwrap();
+    assert_eq!(pole["name"], "pole");
+}
+
+#[test]
 fn sequence_00_summary() {
     let Some(dir) = require("kitti-poles/00") else {
         return;

@@ -179,6 +179,28 @@ proptest! {
     }
 
     #[test]
+    fn label_reader_never_panics_and_keeps_every_whole_label(
+        raw in prop::collection::vec(any::<u32>(), 0..64),
+        cut in 0usize..260,
+    ) {
+        let bytes: Vec<u8> = raw.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let cut = cut.min(bytes.len());
+        match kitti::parse_labels(&bytes[..cut], "l.label") {
+            Ok(labels) => {
+                prop_assert_eq!(cut % 4, 0);
+                prop_assert_eq!(labels.len(), cut / 4);
+                for (label, raw) in labels.iter().zip(&raw) {
+                    prop_assert_eq!(label.raw(), *raw);
+                }
+            }
+            Err(err) => {
+                prop_assert!(cut % 4 != 0);
+                prop_assert_eq!(err.location(), Location::Byte((cut - cut % 4) as u64));
+            }
+        }
+    }
+
+    #[test]
     fn velodyne_reader_never_panics(
         cut in prop_oneof![Just(1.0), 0.0..1.0f64],
         edits in prop::collection::vec((any::<usize>(), any::<u8>()), 0..6),
