@@ -6,7 +6,7 @@
 //!   SLAM-corrected poses are the ground truth). IBuILD and DBoW2-style on rasterised scans
 //!   (the DBoW2-style vocabulary trained offline on the logs of the other fold), planar polar
 //!   context. Online loop closure and kidnapped mode; PR curves as PNG.
-//! * **Real 3-D** ([`kitti_real`]): the 40 real KITTI frames (sequences 00, 01, 04, 07, ten
+//! * **Real 3-D** ([`kitti_real`]): the 40 real KITTI frames and 5 real Ouster frames (KITTI sequences 00, 01, 04, 07, ten
 //!   each) in one database, kidnapped: is each frame's best match a neighbour of the same
 //!   sequence? Real intensity-image statistics beside simulated frames at the same poses.
 //! * **Semi-synthetic KITTI** ([`semi_kitti`]): simulated HDL-64E scans with intensity along
@@ -192,7 +192,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     } else {
         (None, String::new())
     };
-    writeln!(md, "## 2. Real 3-D: 40 real KITTI frames\n")?;
+    writeln!(md, "## 2. Real 3-D: 40 real KITTI frames and 5 real Ouster frames\n")?;
     let s2 = if wanted("2") {
         kitti_real::run(ctx, vocabulary.as_ref())?
     } else {

@@ -1,6 +1,7 @@
 //! Section 2: the 40 real KITTI frames (sequences 00, 01, 04, 07, frames 0–9 each, real
-//! intensity) in one database, kidnapped mode: is each frame's best match (itself excluded) a
-//! neighbour of the same sequence? And the real intensity images beside simulated ones at the
+//! intensity) and the 5 real Ouster frames (reflectivity as intensity) in one database,
+//! kidnapped mode: is each frame's best match (itself excluded) a neighbour of the same
+//! source? And the real intensity images beside simulated ones at the
 //! same poses (semi-synthetic drive of the same sequence).
 
 use std::fmt::Write;
@@ -12,7 +13,7 @@ use rayon::prelude::*;
 use raypath_geometry::{PointCloud, Pose3};
 use raypath_io::sequence::{SweepOptions, SweepSequence};
 use raypath_place_recognition::{
-    BinaryVocabulary, EquirectConfig, Exclusion, GroundTruth, equirectangular,
+    AngularSpan, BinaryVocabulary, EquirectConfig, Exclusion, GroundTruth, equirectangular,
 };
 use raypath_sim::datasets::DEFAULT_SEED;
 use raypath_sim::semi_kitti::{SemiKittiConfig, SemiKittiDrive};
@@ -30,33 +31,67 @@ use crate::table::{Table, fmt_num};
 pub const SEQUENCES: [&str; 4] = ["00", "01", "04", "07"];
 const FRAMES: usize = 10;
 
+/// The real Ouster captures that join the database: name, capture, elevation span of the
+/// images in degrees (the sensors' vertical fields of view: OS-1 ±22.5°, OS-2 ±11.25°).
+const OUSTER: [(&str, &str, f64); 3] = [
+    ("ouster-os1", "ouster/OS-1-128_v2.3.0_1024x10_lb_n3.pcap", 22.5),
+    ("ouster-os2", "ouster/OS-2-128-U1_v2.3.0_1024x10.pcap", 11.25),
+    (
+        "ouster-os1-dual",
+        "ouster/OS-1-128_767798045_1024x10_20230712_120049.pcap",
+        22.5,
+    ),
+];
+
 /// The real frames (sequence index, views), their velodyne poses and the sequences found.
 type Loaded = (Vec<(usize, Views)>, Vec<Pose3>, Vec<&'static str>);
 
-/// Reads the real frames and their velodyne poses (`SweepSequence`: `poses.txt` through the
-/// `Tr` of `calib.txt`); the sequences found.
+
+/// Reads the real frames and their sensor poses (`SweepSequence`: for KITTI `poses.txt`
+/// through the `Tr` of `calib.txt`, for Ouster the vendor's poses beside the capture or the
+/// identity for a single frame); the sources found.
 fn load(ctx: &EvalContext) -> Result<Loaded> {
     let mut frames = Vec::new();
     let mut poses = Vec::new();
     let mut found = Vec::new();
-    for (k, seq) in SEQUENCES.iter().enumerate() {
-        let dir = ctx.data(&format!("kitti/sequences/{seq}"));
+    let kitti = SEQUENCES.iter().map(|seq| {
+        (
+            *seq,
+            format!("kitti/sequences/{seq}"),
+            EquirectConfig::default(),
+        )
+    });
+    let ouster = OUSTER.iter().map(|(name, path, half_fov_deg)| {
+        let mut config = EquirectConfig::default();
+        config.span = AngularSpan::Fixed {
+            elevation_min_rad: -half_fov_deg.to_radians(),
+            elevation_max_rad: half_fov_deg.to_radians(),
+        };
+        (*name, (*path).to_owned(), config)
+    });
+    for (k, (name, relative, config)) in kitti.chain(ouster).enumerate() {
+        let dir = ctx.data(&relative);
         if !dir.exists() {
             continue;
         }
         let sequence = SweepSequence::open(&dir, &SweepOptions::default())?;
-        let seq_poses = sequence.reference.as_deref().unwrap_or_default();
-        if sequence.len() < FRAMES || seq_poses.len() < FRAMES {
+        let n = sequence.len().min(FRAMES);
+        let seq_poses = match sequence.reference.as_deref() {
+            Some(p) if p.len() >= n => p[..n].to_vec(),
+            _ if n == 1 => vec![Pose3::identity()],
+            _ => continue,
+        };
+        if n == 0 || (k < SEQUENCES.len() && n < FRAMES) {
             continue;
         }
-        let clouds: Vec<PointCloud> = (0..FRAMES)
+        let clouds: Vec<PointCloud> = (0..n)
             .map(|i| sequence.sweep(i))
             .collect::<std::result::Result<_, _>>()
             .with_context(|| format!("reading {}", dir.display()))?;
         let views: Vec<(usize, Views)> = clouds
             .into_par_iter()
             .map(|cloud| {
-                let images = equirectangular(&cloud, &EquirectConfig::default())?;
+                let images = equirectangular(&cloud, &config)?;
                 Ok((
                     k,
                     Views {
@@ -70,8 +105,8 @@ fn load(ctx: &EvalContext) -> Result<Loaded> {
             })
             .collect::<Result<_>>()?;
         frames.extend(views);
-        poses.extend_from_slice(&seq_poses[..FRAMES]);
-        found.push(*seq);
+        poses.extend_from_slice(&seq_poses);
+        found.push(name);
     }
     Ok((frames, poses, found))
 }
@@ -171,7 +206,13 @@ pub fn run(ctx: &EvalContext, vocabulary: Option<&Arc<BinaryVocabulary>>) -> Res
         "ms/frame (describe)",
         "note",
     ]);
-    let n = frames.len();
+    // Queries with a neighbour: frames of sources with more than one frame (the single
+    // Ouster frames are in the database as distractors only).
+    let has_neighbour: Vec<bool> = frames
+        .iter()
+        .map(|f| frames.iter().filter(|g| g.0 == f.0).count() > 1)
+        .collect();
+    let n = has_neighbour.iter().filter(|&&h| h).count();
     let mut json_methods = Vec::new();
     let mut fractions = Vec::new();
     for r in &results {
@@ -179,13 +220,13 @@ pub fn run(ctx: &EvalContext, vocabulary: Option<&Arc<BinaryVocabulary>>) -> Res
             .best_match
             .iter()
             .enumerate()
-            .filter(|(i, b)| b.is_some_and(|j| frames[j].0 == frames[*i].0))
+            .filter(|(i, b)| has_neighbour[*i] && b.is_some_and(|j| frames[j].0 == frames[*i].0))
             .count();
         let near = r
             .best_match
             .iter()
             .enumerate()
-            .filter(|(i, b)| b.is_some_and(|j| truth.is_revisit(*i, j)))
+            .filter(|(i, b)| has_neighbour[*i] && b.is_some_and(|j| truth.is_revisit(*i, j)))
             .count();
         let kid = r.kidnapped_summary();
         fractions.push(format!("{} {same}/{n}", r.key()));
@@ -209,13 +250,19 @@ pub fn run(ctx: &EvalContext, vocabulary: Option<&Arc<BinaryVocabulary>>) -> Res
     }
     writeln!(
         md,
-        "Sequences {} (frames 0–9 each, real HDL-64E scans with real intensity; velodyne poses \
-         from `poses.txt` and `calib.txt`) in one database of {n} frames; every frame queried against all (kidnapped, \
-         no temporal consistency). A best match counts as a neighbour when it is another frame \
-         of the same sequence, and as correct when it is also less than 5 m away (the true \
-         pairs: {}). Images: equirectangular 1024 × 64, elevation −24.9°…+2°, intensity scaled \
-         by 1, range by 80 m.\n",
+        "Real sources {} in one database of {} frames: the KITTI sequences (frames 0–9 each, \
+         real HDL-64E scans with real intensity; velodyne poses from `poses.txt` and \
+         `calib.txt`) and the real Ouster captures (OS-1-128: 3 frames with the vendor's poses, \
+         0.25 m apart; one OS-2-128 and one dual-return OS-1-128 frame, in the database as \
+         distractors; reflectivity as the intensity channel). Every frame is queried against \
+         all (kidnapped, no temporal consistency); the counts are over the {n} frames that \
+         have another frame of their own source. A best match counts as a neighbour when it is \
+         another frame of the same source, and as correct when it is also less than 5 m away \
+         (the true pairs: {}). Images: equirectangular 1024 × 64 over the sensor's vertical \
+         field of view (HDL-64E −24.9°…+2°, OS-1 ±22.5°, OS-2 ±11.25°), intensity scaled \
+         automatically, range by 80 m.\n",
         found.join(", "),
+        frames.len(),
         truth.true_pairs()
     )?;
     writeln!(md, "{}", table.to_markdown())?;
