@@ -123,13 +123,18 @@ fn real_kitti_sequence_lists_semantic_classes() {
     };
     let json = info_json(&path);
     assert_eq!(json["scans"], 10);
-    let classes = json["semantic_classes"]["classes"].as_array().expect("classes");
+    let classes = json["semantic_classes"]["classes"]
+        .as_array()
+        .expect("classes");
     let points: u64 = classes.iter().filter_map(|c| c["points"].as_u64()).sum();
     assert_eq!(json["points"].as_u64(), Some(points), "one label per point");
     assert!(classes.iter().any(|c| c["name"] == "traffic-sign"));
     let out = raypath(&["info", path.to_str().expect("UTF-8 path")]);
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("semantic labels (10 labelled frames)"), "{text}");
+    assert!(
+        text.contains("semantic labels (10 labelled frames)"),
+        "{text}"
+    );
     assert!(text.contains("pole"), "{text}");
 }
 

@@ -53,16 +53,22 @@ pub fn require(relative: impl AsRef<Path>) -> Option<PathBuf> {
 /// the reason and returns false, or, when the environment sets `RAYPATH_REQUIRE_PYTHON=1` (CI
 /// does), panics so the missing tool cannot pass unseen.
 pub fn require_python(imports: &str) -> bool {
-    let probe = std::process::Command::new("python3")
+    require_python_in("python3", imports)
+}
+
+/// [`require_python`] for another interpreter, for example a virtual environment's
+/// `…/bin/python` holding a tool whose pinned dependencies clash with the other tools'.
+pub fn require_python_in(python: &str, imports: &str) -> bool {
+    let probe = std::process::Command::new(python)
         .args(["-c", &format!("import {imports}")])
         .output();
     let reason = match probe {
         Ok(out) if out.status.success() => return true,
         Ok(out) => format!(
-            "python3 cannot import {imports}: {}",
+            "{python} cannot import {imports}: {}",
             String::from_utf8_lossy(&out.stderr).trim()
         ),
-        Err(e) => format!("python3 not runnable: {e}"),
+        Err(e) => format!("{python} not runnable: {e}"),
     };
     if std::env::var("RAYPATH_REQUIRE_PYTHON").is_ok_and(|v| v == "1") {
         panic!("RAYPATH_REQUIRE_PYTHON=1 but {reason}");

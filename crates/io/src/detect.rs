@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::summary::Summary;
-use crate::{carmen, kitti, nclt, octomap, pcd, point_csv, segcomp, source, xyz};
+use crate::{carmen, kitti, nclt, octomap, ouster, pcd, point_csv, segcomp, source, xyz};
 
 /// The file formats and directory layouts raypath reads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
@@ -56,11 +56,16 @@ pub enum Format {
     /// A rosbag2 recording with MCAP storage: its directory (with `metadata.yaml`) or its
     /// `.mcap` file.
     Rosbag2,
+    /// Ouster lidar packets in a pcap/pcapng capture, with the sensor's metadata JSON beside
+    /// it (found by [`ouster::find_metadata`]).
+    OusterPcap,
+    /// Ouster OSF recording (`.osf`): recognized, not read.
+    OusterOsf,
 }
 
 impl Format {
     /// Every format, in documentation order.
-    pub const ALL: [Format; 21] = [
+    pub const ALL: [Format; 23] = [
         Format::Carmen,
         Format::Pcd,
         Format::Xyz,
@@ -82,6 +87,8 @@ impl Format {
         Format::SegcompGtAng,
         Format::PointCsv,
         Format::Rosbag2,
+        Format::OusterPcap,
+        Format::OusterOsf,
     ];
 
     /// The format with this [`Format::name`].
@@ -113,6 +120,8 @@ impl Format {
             Format::SegcompGtAng => "segcomp-gt-ang",
             Format::PointCsv => "point-csv",
             Format::Rosbag2 => "rosbag2",
+            Format::OusterPcap => "ouster-pcap",
+            Format::OusterOsf => "ouster-osf",
         }
     }
 
@@ -142,6 +151,15 @@ impl Format {
 
         if head.starts_with(b"# Octomap OcTree binary file") {
             return Ok(Format::OctomapBt);
+        }
+        if ouster::is_osf(path, &head) {
+            return Ok(Format::OusterOsf);
+        }
+        if ouster::is_capture_name(path)
+            || (ouster::is_capture_head(&head) && !stem.ends_with(".bin"))
+        {
+            ouster::find_metadata(path)?;
+            return Ok(Format::OusterPcap);
         }
         if head.len() >= 8 && u64::from_le_bytes(head_8(&head)) == nclt::HITS_MAGIC {
             return Ok(Format::NcltVelodyneHits);
@@ -216,7 +234,7 @@ impl fmt::Display for Format {
 
 const SUPPORTED: &str = "raypath reads CARMEN logs (.log/.clf[.gz|.bz2]), PCD, OctoMap .bt/.graph, \
     x y z text, KITTI and NCLT directories and files, SegComp range and ground-truth files, \
-    and point CSVs with an x,y header";
+    point CSVs with an x,y header, and Ouster pcap captures with their metadata JSON";
 
 /// Summarizes a file or directory of any supported format (what `raypath info` prints).
 pub fn summarize(path: &Path) -> Result<Summary> {
@@ -248,6 +266,8 @@ pub fn summarize_as(path: &Path, format: Format) -> Result<Summary> {
         }
         Format::PointCsv => point_csv::summarize(path),
         Format::Rosbag2 => bag_summary(path),
+        Format::OusterPcap => ouster::summarize(path),
+        Format::OusterOsf => Err(ouster::osf_unsupported(path)),
     }
 }
 

@@ -14,6 +14,8 @@
 //!   installation (own CDR decoder; the message types and what is ignored are listed there);
 //!   [`foxglove`] writes results as an MCAP that Foxglove opens with no plugin; [`convert`]
 //!   turns CARMEN logs, KITTI sequences and PCD files into bags and back.
+//! * **Ouster.** [`ouster`] decodes Ouster lidar packets from pcap/pcapng captures with the
+//!   sensor's metadata JSON into organized range images and point clouds with reflectivity.
 //!
 //! * **Streaming.** Logs and packet streams are read record by record through iterators;
 //!   a 100 MB log never sits in memory whole. gzip and bzip2 are recognized by their first
@@ -59,6 +61,7 @@ pub mod kitti;
 pub mod lzw;
 pub mod nclt;
 pub mod octomap;
+pub mod ouster;
 pub mod pcd;
 pub mod point_csv;
 pub mod poles_csv;

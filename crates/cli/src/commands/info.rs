@@ -12,7 +12,8 @@ pub struct Args {
     /// A file (CARMEN log, PCD, OctoMap .bt/.graph, xyz text, KITTI/NCLT file, SegComp file,
     /// point CSV; plain, .gz or .bz2), a KITTI sequence / NCLT session directory, or a rosbag2
     /// bag (its directory with metadata.yaml, or its .mcap file: topics, types, counts, rates,
-    /// time span).
+    /// time span), or an Ouster .pcap/.pcapng with its metadata .json beside it (frames,
+    /// columns × beams, profile, valid returns, range span).
     pub path: PathBuf,
     /// Print one JSON object (keys: format, scans, beams, points, poses, odometry, width,
     /// height, labels, bbox, time_span, nodes, and format-specific entries).

@@ -81,10 +81,14 @@ fn bad(name: &Path, reason: impl Into<String>) -> Error {
 }
 
 impl SweepSequence {
-    /// Opens a KITTI sequence, an NCLT session (detected from the directory contents) or a
-    /// rosbag2 recording. A KITTI dataset root holding exactly one sequence under
+    /// Opens a KITTI sequence, an NCLT session (detected from the directory contents), a
+    /// rosbag2 recording or an Ouster capture (`.pcap`/`.pcapng`, see
+    /// [`crate::ouster::open_sweeps`]). A KITTI dataset root holding exactly one sequence under
     /// `sequences/` opens that sequence.
     pub fn open(path: &Path, options: &SweepOptions) -> Result<Self> {
+        if path.is_file() && crate::ouster::is_capture_name(path) {
+            return crate::ouster::open_sweeps(path);
+        }
         if crate::rosbag::is_bag(path)? {
             return crate::rosbag::open_sweeps(path, &options.topics);
         }
