@@ -1,6 +1,8 @@
 //! `cargo xtask eval sim`: what each simulated data set contains, its statistics beside the
 //! real samples and the thesis, checks that raypath-io reads every file, and pictures.
 
+mod realism;
+
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
@@ -64,8 +66,8 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     let mut md = String::from(
         "Simulated data sets written by `raypath-sim` (`cargo xtask datasets generate`) in the \
          real formats, read back here through `raypath-io` exactly like real data. **Every row \
-         of this page is simulated**, except the columns marked *real*, which are measured on \
-         the real samples in `RAYPATH_DATA` or quoted from the thesis.\n\n",
+         of this page is simulated**, except the columns and rows marked *real*, which are \
+         measured on the real samples in `RAYPATH_DATA` or quoted from the thesis.\n\n",
     );
 
     // What each set holds and whether raypath-io reads all of it.
@@ -115,6 +117,9 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     md.push_str("\n## Statistics beside the real data and the thesis\n\n");
     md.push_str(&comparison_table(&sets, ctx)?.to_markdown());
 
+    md.push_str("\n## Realism: real KITTI frames beside simulated frames at the same places\n\n");
+    let realism = realism::run(ctx, &mut md)?;
+
     md.push_str("\n## Pictures\n\n");
     let figures = ctx.figure_dir("sim")?;
     for set in &sets {
@@ -130,6 +135,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         })).collect::<Vec<_>>(),
         "readability": readability,
         "skipped": skipped,
+        "realism": realism,
     });
     Ok(EvalReport {
         name: "sim",
