@@ -5,6 +5,7 @@
 //! raypath convert <in> <out> [--to carmen|kitti|pcd|rosbag2] [--json]
 //! raypath simulate <kind> --out DIR [--seed S] [--quick] [--scans N] [--json]
 //! raypath simulate semi-kitti --poses poses.txt --times times.txt --poles poles.csv --out DIR
+//! raypath register <source> <target> | <sequence> [--json]
 //! ```
 //!
 //! Every subcommand prints a human-readable report, or with `--json` one JSON document on
@@ -81,6 +82,9 @@ enum Command {
     /// closure, robust pose graph; trajectory, corrected log, map and, with a corrected log,
     /// the relation errors of Kümmerle et al. (2009).
     Slam(commands::slam::Args),
+    /// 3-D scan registration: two scans by point-to-plane ICP, or a KITTI/NCLT/Ouster/bag
+    /// sequence by KISS-ICP-style odometry, with errors against its reference poses.
+    Register(commands::register::Args),
 }
 
 fn main() -> ExitCode {
@@ -102,6 +106,7 @@ fn main() -> ExitCode {
         Command::CalibrateIntensity(args) => commands::calibrate_intensity::run(args),
         Command::LoopClosure(args) => commands::loop_closure::run(args),
         Command::Slam(args) => commands::slam::run(args),
+        Command::Register(args) => commands::register::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -55,12 +55,19 @@ fn real_frames_have_one_semantic_label_per_point() {
             assert_eq!(labels.len(), scan.points.len());
             let counts = kitti::count_classes(&labels);
             // Every class is one SemanticKITTI defines; roads and poles are there.
-            assert!(counts.keys().all(|&c| kitti::semantic_class_name(c).is_some()));
+            assert!(
+                counts
+                    .keys()
+                    .all(|&c| kitti::semantic_class_name(c).is_some())
+            );
             assert!(counts[&40].points > 10_000, "sequence {seq}: road");
             poles += counts.get(&80).map_or(0, |c| c.points);
         }
         // The data README: ≈ 600–720 pole points per frame.
-        assert!((4000..9000).contains(&poles), "sequence {seq}: {poles} pole points");
+        assert!(
+            (4000..9000).contains(&poles),
+            "sequence {seq}: {poles} pole points"
+        );
     }
     let summary = raypath_io::summarize(&root.join("00")).unwrap();
     let classes = &summary.extra["semantic_classes"];

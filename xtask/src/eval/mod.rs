@@ -15,6 +15,7 @@ mod place_recognition;
 mod poles_kitti;
 mod poles_nclt;
 mod polylines;
+mod registration;
 mod scan_matching;
 mod segcomp;
 mod sensor_models;
@@ -164,6 +165,11 @@ const EVALUATIONS: &[(&str, &str, EvalFn)] = &[
         "place-recognition",
         "IBuILD loop closure and lidar place recognition beside DBoW2, Scan Context, HOG, GIST, SHOT (Khan ch. 4)",
         place_recognition::run,
+    ),
+    (
+        "registration",
+        "3-D point-to-plane ICP and KISS-ICP-style odometry on the real KITTI and Ouster frames",
+        registration::run,
     ),
 ];
 

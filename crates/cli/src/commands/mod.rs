@@ -12,6 +12,7 @@ pub mod planes;
 pub mod poles;
 pub mod polylines;
 pub mod record;
+pub mod register;
 pub mod scan_match;
 pub mod score_model;
 pub mod segcomp_eval;

@@ -165,7 +165,13 @@ mod tests {
         assert_eq!(label.raw(), raw);
         let bytes: Vec<u8> = [raw, 40].iter().flat_map(|v| v.to_le_bytes()).collect();
         let labels = parse_labels(&bytes, "x.label").unwrap();
-        assert_eq!(labels[1], PointLabel { class: 40, instance: 0 });
+        assert_eq!(
+            labels[1],
+            PointLabel {
+                class: 40,
+                instance: 0
+            }
+        );
     }
 
     #[test]
@@ -181,7 +187,10 @@ mod tests {
     fn truncated_file_names_the_byte() {
         let err = parse_labels(&[0, 0, 0, 0, 1], "seq/labels/000001.label").unwrap_err();
         let text = err.to_string();
-        assert!(text.contains("000001.label") && text.contains("byte 4"), "{text}");
+        assert!(
+            text.contains("000001.label") && text.contains("byte 4"),
+            "{text}"
+        );
     }
 
     #[test]
@@ -191,7 +200,19 @@ mod tests {
             .map(PointLabel::from_raw)
             .collect();
         let counts = count_classes(&labels);
-        assert_eq!(counts[&80], ClassCount { points: 3, instances: 2 });
-        assert_eq!(counts[&40], ClassCount { points: 2, instances: 0 });
+        assert_eq!(
+            counts[&80],
+            ClassCount {
+                points: 3,
+                instances: 2
+            }
+        );
+        assert_eq!(
+            counts[&40],
+            ClassCount {
+                points: 2,
+                instances: 0
+            }
+        );
     }
 }

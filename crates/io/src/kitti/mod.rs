@@ -45,8 +45,8 @@ use crate::{Error, Format, Location, Result};
 
 pub use calib::{KittiCalib, parse_calib, read_calib};
 pub use labels::{
-    ClassCount, LABEL_BYTES, PointLabel, check_label_count, count_classes, parse_labels, read_labels,
-    semantic_class_name,
+    ClassCount, LABEL_BYTES, PointLabel, check_label_count, count_classes, parse_labels,
+    read_labels, semantic_class_name,
 };
 pub use poses::{
     flu_from_camera, parse_poses, parse_times, read_poses, read_times, velodyne_poses,
@@ -205,7 +205,9 @@ fn label_classes(sequence: &KittiSequence) -> Result<Option<serde_json::Value>> 
             })
         })
         .collect();
-    Ok(Some(serde_json::json!({ "frames": labelled, "classes": rows })))
+    Ok(Some(
+        serde_json::json!({ "frames": labelled, "classes": rows }),
+    ))
 }
 
 /// Reads the next line of `lines` into `buf` (reused, so no allocation per line), for parsers
