@@ -291,6 +291,22 @@ impl IntensityLut {
         value.is_finite().then_some(value)
     }
 
+    /// Whether `(r, α)` lies in the calibrated domain: inside the table and nearest to a node
+    /// inside the reference samples' convex hull (elsewhere [`lookup`](Self::lookup) clamps).
+    pub fn covers(&self, range_m: f64, incidence_rad: f64) -> bool {
+        let fi = (range_m - self.range_min_m) / self.range_step_m;
+        let fj = (incidence_rad - self.angle_min_rad) / self.angle_step_rad;
+        let inside_table = |f: f64, n: usize| f.is_finite() && f >= -0.5 && f <= n as f64 - 0.5;
+        if !(inside_table(fi, self.ranges) && inside_table(fj, self.angles)) {
+            return false;
+        }
+        let (i, j) = (fi.round().max(0.0) as usize, fj.round().max(0.0) as usize);
+        self.inside_hull
+            .get(i.min(self.ranges - 1) * self.angles + j.min(self.angles - 1))
+            .copied()
+            .unwrap_or(false)
+    }
+
     /// The relative reflectivity ϱ̄ = I / I_ref(r, α) (eq. 3.5); `None` where the table is not
     /// positive or the input is not finite.
     pub fn relative(&self, intensity: f64, range_m: f64, incidence_rad: f64) -> Option<f64> {

@@ -112,3 +112,28 @@ proptest! {
         let _ = read_samples_csv(bytes.as_slice(), "fuzz.csv");
     }
 }
+
+#[test]
+fn covers_the_samples_hull_only() {
+    // Samples on a triangle in (r, α): r ∈ [1, 10] m, α ≤ (10 − r)·5°.
+    let mut s = Vec::new();
+    for i in 0..=18 {
+        let r = 1.0 + 0.5 * i as f64;
+        for j in 0..=10 {
+            let a = ((10.0 - r) * 5.0 * j as f64 / 10.0).to_radians();
+            s.push(CalibrationSample {
+                range_m: r,
+                incidence_rad: a,
+                intensity: reference(r, a),
+            });
+        }
+    }
+    let lut = IntensityLut::fit(&s, &LutConfig::default()).unwrap();
+    assert!(lut.covers(2.0, 10f64.to_radians()));
+    assert!(lut.covers(9.0, 2f64.to_radians()));
+    // Above the hypotenuse, outside the table, not finite.
+    assert!(!lut.covers(9.0, 40f64.to_radians()));
+    assert!(!lut.covers(12.0, 0.0));
+    assert!(!lut.covers(0.5, 0.0));
+    assert!(!lut.covers(f64::NAN, 0.0));
+}
