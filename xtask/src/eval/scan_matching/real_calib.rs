@@ -256,10 +256,10 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
          reflectance{}.\n",
         raw_cv.len(),
         if better * 2 < raw_cv.len() {
-            ": on real KITTI it falls short of the simulated section. KITTI's reflectance channel \
-             is already normalised by the sensor, so what remains is per-laser gain and surface \
-             texture, which a table over (r, α) cannot remove (Khan calibrated raw intensities \
-             of his own 2-D scanner)"
+            ": on real KITTI it falls short of the simulated section. The spread that remains \
+             is not a function of (r, α) alone; per-laser gains and surface texture are the \
+             likely causes, not separated here (Khan calibrated the raw intensities of his own \
+             2-D scanner, whereas KITTI ships a processed reflectance)"
         } else {
             ""
         }
