@@ -62,7 +62,8 @@ pub use grid::{Grid2, Grid3};
 pub use point_cloud::PointCloud;
 pub use pose::{Pose2, Pose3, wrap_angle};
 pub use range_image::{
-    BeamDirections, MAX_PIXELS, RangeImage, SphericalProjection, spherical_direction,
+    BeamDirections, MAX_PIXELS, RangeImage, RingAssignment, RingProjection, SphericalProjection,
+    spherical_direction,
 };
 pub use ray::{Range, Ray2, Ray3};
 pub use scan2::Scan2;

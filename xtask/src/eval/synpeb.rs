@@ -21,6 +21,8 @@ use raypath_planes::{
 use super::{EvalContext, EvalReport, median};
 use crate::table::{Table, fmt_num};
 
+mod real;
+
 const NAME: &str = "synpeb";
 const LEVELS: [&str; 5] = ["0.0", "0.5", "1.0", "2.0", "4.0"];
 
@@ -353,6 +355,8 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         format!("{} (PPE/PEAC = {:.0}×)", fmt_num(peac_t2, 3), t2 / peac_t2),
         "–".into(),
     ]);
+    let (real_md, real_json) = real::run(ctx)?;
+    results.insert("real_scans".into(), real_json);
     let threads = rayon::current_num_threads();
     let markdown = format!(
         "PPE (`raypath_planes::extract` with the preset of each noise level, below), the \
@@ -374,7 +378,8 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          download, so the figures are comparable in kind, not in value.\n\n{RMSE_NOTE}\n\
          **Closing note:** at σ = 2 cm PPE takes a median {t2:.2} s per 500 × 500 scan here, \
          {speedup:.0}× faster than the thesis' 1.6 h (5760 s) per scan, with f = {f2:.1} % and \
-         RMSE = {rmse2:.1} mm on our generated scans; the PEAC-style baseline takes {peac_t2:.3} s.\n",
+         RMSE = {rmse2:.1} mm on our generated scans; the PEAC-style baseline takes {peac_t2:.3} s.\n\n\
+         {real_md}",
         bs = peac_params.block_size,
         sig = peac_params.depth_sigma_per_m,
         it = peac_params.init_tol_m,

@@ -6,7 +6,8 @@
 //! elevation) and columns the firing azimuths (column 0 at the largest azimuth, so the image
 //! reads left to right like a panorama seen from the sensor) — the layout that
 //! [`SphericalProjection`] produces (as in Khan 2017, App. A.1, and the usual lidar
-//! projections of RangeNet++ and friends).
+//! projections of RangeNet++ and friends). [`RingProjection`] builds the same layout from a
+//! scan stored ring by ring (KITTI's Velodyne files), one row per laser.
 //!
 //! **No-returns** are kept: their range is `NaN` (`f32`), the same marker an organized
 //! [`PointCloud`] uses for a missing point, so a no-return still knows its beam direction
@@ -15,9 +16,11 @@
 //! from disk, REP-103), the sensor origin is given in that frame when converting.
 
 mod directions;
+mod rings;
 mod spherical;
 
 pub use directions::{BeamDirections, spherical_direction};
+pub use rings::{RingAssignment, RingProjection};
 pub use spherical::SphericalProjection;
 
 use nalgebra::{Point3, Unit, Vector3};
