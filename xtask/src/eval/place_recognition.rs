@@ -192,7 +192,10 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     } else {
         (None, String::new())
     };
-    writeln!(md, "## 2. Real 3-D: 40 real KITTI frames and 5 real Ouster frames\n")?;
+    writeln!(
+        md,
+        "## 2. Real 3-D: 40 real KITTI frames and 5 real Ouster frames\n"
+    )?;
     let s2 = if wanted("2") {
         kitti_real::run(ctx, vocabulary.as_ref())?
     } else {

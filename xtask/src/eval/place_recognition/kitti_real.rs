@@ -34,8 +34,16 @@ const FRAMES: usize = 10;
 /// The real Ouster captures that join the database: name, capture, elevation span of the
 /// images in degrees (the sensors' vertical fields of view: OS-1 ±22.5°, OS-2 ±11.25°).
 const OUSTER: [(&str, &str, f64); 3] = [
-    ("ouster-os1", "ouster/OS-1-128_v2.3.0_1024x10_lb_n3.pcap", 22.5),
-    ("ouster-os2", "ouster/OS-2-128-U1_v2.3.0_1024x10.pcap", 11.25),
+    (
+        "ouster-os1",
+        "ouster/OS-1-128_v2.3.0_1024x10_lb_n3.pcap",
+        22.5,
+    ),
+    (
+        "ouster-os2",
+        "ouster/OS-2-128-U1_v2.3.0_1024x10.pcap",
+        11.25,
+    ),
     (
         "ouster-os1-dual",
         "ouster/OS-1-128_767798045_1024x10_20230712_120049.pcap",
@@ -45,7 +53,6 @@ const OUSTER: [(&str, &str, f64); 3] = [
 
 /// The real frames (sequence index, views), their velodyne poses and the sequences found.
 type Loaded = (Vec<(usize, Views)>, Vec<Pose3>, Vec<&'static str>);
-
 
 /// Reads the real frames and their sensor poses (`SweepSequence`: for KITTI `poses.txt`
 /// through the `Tr` of `calib.txt`, for Ouster the vendor's poses beside the capture or the
@@ -62,10 +69,12 @@ fn load(ctx: &EvalContext) -> Result<Loaded> {
         )
     });
     let ouster = OUSTER.iter().map(|(name, path, half_fov_deg)| {
-        let mut config = EquirectConfig::default();
-        config.span = AngularSpan::Fixed {
-            elevation_min_rad: -half_fov_deg.to_radians(),
-            elevation_max_rad: half_fov_deg.to_radians(),
+        let config = EquirectConfig {
+            span: AngularSpan::Fixed {
+                elevation_min_rad: -half_fov_deg.to_radians(),
+                elevation_max_rad: half_fov_deg.to_radians(),
+            },
+            ..EquirectConfig::default()
         };
         (*name, (*path).to_owned(), config)
     });
