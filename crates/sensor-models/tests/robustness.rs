@@ -211,3 +211,52 @@ proptest! {
         }
     }
 }
+
+/// Found by `never_nan_or_infinite_2d`: every observed cell is all hits or all misses, so the
+/// method-of-moments Beta prior sits at the edge of the family (α + β ≈ 2e-16), a hit-only
+/// cell's posterior μ rounds to 1 and a ray crossing it scored ln 0.
+#[test]
+fn posterior_with_edge_prior_stays_finite() {
+    let grid = Grid2::new(Point2::new(1.0, -7.375), 1.615_223_108_502_324_8, [22, 2]).unwrap();
+    let mut stats = DenseStats2::new(grid);
+    let map_rays = [
+        (
+            3.644_991_970_100_494,
+            -5.827_569_308_576_28,
+            0.0,
+            -1.0,
+            0.537_291_451_869_976_1,
+        ),
+        (
+            1.783_002_911_625_136_2,
+            -7.253_607_801_517_596,
+            1.0,
+            0.0,
+            1.228_852_288_162_532,
+        ),
+        (
+            15.190_740_724_777_216,
+            -7.375,
+            1.0,
+            0.0,
+            63.169_238_223_437_3,
+        ),
+    ];
+    for (x, y, dx, dy, r) in map_rays {
+        let ray = Ray2::new(Point2::new(x, y), Vector2::new(dx, dy), Range::Hit(r)).unwrap();
+        stats.insert_ray(&ray, &MappingConfig::default());
+    }
+    let model = ReflectionModel::posterior(&stats, BetaPosteriorConfig::default()).unwrap();
+    let prior = model.prior().unwrap();
+    assert!(
+        prior.alpha + prior.beta < 1e-10,
+        "the case needs an edge prior: {prior:?}"
+    );
+    let across_hit_cell = Ray2::new(
+        Point2::new(1.807_611_554_251_162_4, -6.567_388_445_748_838),
+        Vector2::new(1.0, 0.0),
+        Range::Hit(2.422_834_662_753_487),
+    )
+    .unwrap();
+    check("reflection posterior", &model, &across_hit_cell).unwrap();
+}

@@ -67,6 +67,30 @@ impl<D: Dimension> BernoulliField<D> {
         }
     }
 
+    /// A field whose cell `i` has `μ_i = a_i / (a_i + b_i)` for the pairs `(a_i, b_i)` of
+    /// `weights` (each `a_i, b_i > 0`, e.g. posterior pseudo-hits and pseudo-misses).
+    /// Both logarithms are taken of the weights, not of `μ_i`, so a cell with
+    /// `b_i ≪ a_i` keeps a finite `ln(1 − μ_i)` where `1 − μ_i` rounds to zero.
+    pub(crate) fn from_weights(
+        grid: D::Grid,
+        weights: impl Iterator<Item = (f64, f64)>,
+        outside_probability: f64,
+        range: SensorRange,
+    ) -> Self {
+        Self {
+            grid,
+            log_probs: weights
+                .map(|(a, b)| {
+                    let ln_total = (a + b).ln();
+                    [a.ln() - ln_total, b.ln() - ln_total]
+                })
+                .collect(),
+            outside_probability,
+            outside: log_pair(outside_probability),
+            range,
+        }
+    }
+
     /// The grid.
     pub fn grid(&self) -> &D::Grid {
         &self.grid

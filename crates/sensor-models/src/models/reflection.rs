@@ -137,17 +137,15 @@ impl<D: Dimension> ReflectionModel<D> {
             Some(prior) => BetaPrior::new(prior.alpha, prior.beta)?,
             None => BetaPrior::estimate(stats.cells()),
         };
-        let probabilities = stats.cells().iter().map(|cell| {
-            let a = cell.h() + prior.alpha;
-            a / (a + cell.m() + prior.beta) // Eq. (8.22), δ = 1
-        });
+        // Eq. (8.22), δ = 1: μ = (h + α) / (h + α + m + β), kept as the two weights so that
+        // a method-of-moments prior with α + β ≪ 1 (moments at the edge of the Beta family)
+        // cannot round μ to 1 and a crossed cell to ln 0.
+        let weights = stats
+            .cells()
+            .iter()
+            .map(|cell| (cell.h() + prior.alpha, cell.m() + prior.beta));
         Ok(Self {
-            field: BernoulliField::from_probabilities(
-                *stats.grid(),
-                probabilities,
-                prior.mean(),
-                config.range,
-            ),
+            field: BernoulliField::from_weights(*stats.grid(), weights, prior.mean(), config.range),
             prior: Some(prior),
         })
     }
