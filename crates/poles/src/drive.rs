@@ -26,6 +26,9 @@ use raypath_geometry::{PointCloud, Pose3};
 use raypath_io::sequence::{SweepFormat, SweepOptions, SweepSequence};
 
 use crate::error::{PoleError, Result};
+#[cfg(doc)]
+use crate::sweep::SweepMotion;
+use crate::sweep::SweepTiming;
 
 /// The layout a drive was read from, as far as presets and odometry noise go.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -75,6 +78,13 @@ pub struct Drive {
     /// Per scan: standard deviations `[x m, y m, yaw rad]` of the odometry increment from the
     /// previous scan, when the drive states them (NCLT `odometry_cov.csv`).
     pub odometry_std: Option<Vec<[f64; 3]>>,
+    /// When the scans are de-skewed sweeps of a moving sensor, their timing: local maps then
+    /// trace every ray from where the sensor was when it measured the point
+    /// ([`SweepMotion::from_poses`] along the registration track). `None` (the default of
+    /// every constructor): rays from each scan's origin, right for scans measured from one
+    /// pose such as the simulated ones; set `Some(SweepTiming::kitti())` for real KITTI
+    /// sweeps.
+    pub sweep_timing: Option<SweepTiming>,
     sweeps: SweepSequence,
 }
 
@@ -127,6 +137,7 @@ impl Drive {
             ground_truth,
             odometry,
             odometry_std: sweeps.odometry_std.take(),
+            sweep_timing: None,
             sweeps,
         })
     }

@@ -15,6 +15,7 @@ use crate::hitmiss::HitMissGrid;
 use crate::params::PoleParams;
 use crate::pole::Pole;
 use crate::score::{ScoreVolume, pole_scores};
+use crate::sweep::SweepMotion;
 
 /// What one extraction did, for speed figures.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -48,10 +49,22 @@ pub fn extract_poles(
     center: &Point3<f64>,
     params: &PoleParams,
 ) -> Result<(Vec<Pole>, ExtractionStats)> {
+    extract_poles_from_sweeps(scans, None, center, params)
+}
+
+/// [`extract_poles`] for de-skewed sweeps: with `motions` (one per scan), every ray is
+/// traced from where the sensor was when it measured the point
+/// ([`HitMissGrid::insert_sweeps_par`]).
+pub fn extract_poles_from_sweeps(
+    scans: &[(Pose3, &PointCloud)],
+    motions: Option<&[SweepMotion]>,
+    center: &Point3<f64>,
+    params: &PoleParams,
+) -> Result<(Vec<Pole>, ExtractionStats)> {
     let grid = local_grid(center, params)?;
     let started = Instant::now();
     let mut counts = HitMissGrid::new(grid);
-    counts.insert_scans_par(scans, params.max_range_m);
+    counts.insert_sweeps_par(scans, motions, params.max_range_m);
     let trace_secs = started.elapsed().as_secs_f64();
     let (poles, mut stats) = poles_from_counts(&counts, params)?;
     stats.trace_secs = trace_secs;

@@ -11,6 +11,7 @@ use nalgebra::Point3;
 use rayon::prelude::*;
 use raypath_geometry::{Grid3, PointCloud, Pose3};
 
+use crate::sweep::SweepMotion;
 use crate::tracer::Tracer;
 
 /// Hit and miss counts per voxel of a [`Grid3`] (linear index, x fastest), saturating
@@ -69,6 +70,18 @@ impl HitMissGrid {
     /// sequential insertion unless a voxel saturates). Points farther than `max_range_m` from
     /// the sensor are skipped.
     pub fn insert_scans_par(&mut self, scans: &[(Pose3, &PointCloud)], max_range_m: f64) {
+        self.insert_sweeps_par(scans, None, max_range_m);
+    }
+
+    /// [`insert_scans_par`](Self::insert_scans_par) for de-skewed sweeps: with `motions`
+    /// (one per scan), the ray of every point starts where the sensor was when it measured
+    /// the point ([`SweepMotion::origin`]), not at the scan's origin.
+    pub fn insert_sweeps_par(
+        &mut self,
+        scans: &[(Pose3, &PointCloud)],
+        motions: Option<&[SweepMotion]>,
+        max_range_m: f64,
+    ) {
         let total: usize = scans.iter().map(|(_, c)| c.len()).sum();
         if total == 0 {
             return;
@@ -87,7 +100,8 @@ impl HitMissGrid {
                 let Some((pose, cloud)) = scans.get(s) else {
                     continue;
                 };
-                let origin = Point3::from(pose.translation());
+                let fixed_origin = Point3::from(pose.translation());
+                let motion = motions.and_then(|m| m.get(s));
                 let Some(points) = cloud.points.get(start..end) else {
                     continue;
                 };
@@ -100,6 +114,10 @@ impl HitMissGrid {
                         continue;
                     }
                     let endpoint = pose.transform_point(&local);
+                    let origin = match motion {
+                        Some(m) => pose.transform_point(&m.origin(&local)),
+                        None => fixed_origin,
+                    };
                     tracer.trace(hits, misses, &origin, &endpoint);
                     rays += 1;
                 }
@@ -168,6 +186,39 @@ fn add_into(total: &mut [u16], part: &[u16]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sweep_rays_start_where_the_sensor_was() {
+        use crate::sweep::{SweepMotion, SweepTiming};
+        use nalgebra::Vector3;
+        // 0.1 m voxels over x −1..1, y −6..1, z −0.5..0.5; one point 5 m to the right.
+        let grid = Grid3::new(Point3::new(-1.0, -6.0, -0.5), 0.1, [20, 70, 10]).expect("grid");
+        let cloud = PointCloud::from_points(vec![Point3::new(0.05, -5.0, 0.05)]);
+        let scans = [(Pose3::identity(), &cloud)];
+        let motion = [SweepMotion {
+            translation_m: Vector3::new(0.8, 0.0, 0.0),
+            timing: SweepTiming::kitti(),
+        }];
+        let voxel = |x: f64, y: f64| {
+            let cell = grid.cell_of(&Point3::new(x, y, 0.05)).expect("inside");
+            grid.linear_index(cell)
+        };
+        let mut fixed = HitMissGrid::new(grid);
+        fixed.insert_sweeps_par(&scans, None, 100.0);
+        let mut moving = HitMissGrid::new(grid);
+        moving.insert_sweeps_par(&scans, Some(&motion), 100.0);
+        // Fired a quarter turn after facing forward: from (0.2, 0, 0), not the origin; half
+        // way to the point the ray is at x = 0.125 instead of 0.05.
+        let half = |x: f64| voxel(x, -2.45);
+        assert_eq!(fixed.misses()[half(0.05)], 1);
+        assert_eq!(fixed.misses()[half(0.125)], 0);
+        assert_eq!(moving.misses()[half(0.05)], 0);
+        assert_eq!(moving.misses()[half(0.125)], 1);
+        // The hit is the point either way.
+        let end = voxel(0.05, -4.95);
+        assert_eq!((fixed.hits()[end], moving.hits()[end]), (1, 1));
+        assert_eq!(moving.rays(), 1);
+    }
 
     #[test]
     fn a_ray_misses_the_way_and_hits_the_end() {

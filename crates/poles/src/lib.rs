@@ -32,6 +32,17 @@
 //! run every 1 m of ground-truth arc length (`raypath-localizer::eval`). [`Drive`] reads KITTI
 //! and NCLT layouts.
 //!
+//! Real sweeps: a de-skewed sweep of a moving sensor (KITTI's) holds its points in one frame,
+//! but each beam started where the sensor was when it fired; rays traced from the frame's
+//! origin instead carve free space through thin poles. With [`SweepMotion`]s
+//! ([`extract_poles_from_sweeps`], [`Drive::sweep_timing`], [`LabelledLocalMap`]) every ray
+//! starts at the sensor's position at its firing time ([`SweepTiming::kitti`]).
+//!
+//! Detection quality on labelled scans ([`LabelledLocalMap`]: real SemanticKITTI frames or
+//! simulated ones): reference poles clustered from the pole, trunk and traffic-sign points
+//! ([`reference_poles`]; SemanticKITTI gives these classes no instances), scored per class
+//! ([`class_quality`]).
+//!
 //! ## Example
 //!
 //! ```
@@ -102,23 +113,27 @@ mod error;
 mod extract;
 mod filters;
 mod hitmiss;
+mod labelled;
 mod localize;
 mod mapping;
 mod params;
 mod pipeline;
 mod pole;
 mod pole_map;
+mod reference;
 mod score;
+mod sweep;
 mod tracer;
 
 pub use beta::ReflectionPrior;
 pub use drive::{Drive, DriveFormat, ScanError, ScanFn};
 pub use error::{PoleError, Result};
 pub use extract::{
-    ExtractionStats, extract_poles, local_grid, non_maximum_suppression, occupancy,
-    poles_from_counts,
+    ExtractionStats, extract_poles, extract_poles_from_sweeps, local_grid, non_maximum_suppression,
+    occupancy, poles_from_counts,
 };
 pub use hitmiss::HitMissGrid;
+pub use labelled::{LabelledLocalMap, ScoringRegion};
 pub use localize::{FilterParams, PoleFilter, PoleIndex};
 pub use mapping::{Segment, SlidingWindowFilter, merge_poles, overlap_clusters, segments};
 pub use params::PoleParams;
@@ -130,4 +145,9 @@ pub use pole::Pole;
 pub use pole_map::{
     POLE_MAP_HEADER, parse_pole_csv, read_pole_csv, write_pole_csv, write_pole_csv_to,
 };
+pub use reference::{
+    PoleClass, ReferencePole, ReferenceRule, ReferenceSet, class_quality, greedy_matches,
+    reference_poles,
+};
 pub use score::{ScoreVolume, pole_scores};
+pub use sweep::{SweepMotion, SweepTiming};

@@ -70,8 +70,8 @@ pub fn segments(positions: &[Point3<f64>], interval_m: f64, length_m: f64) -> Ve
     out
 }
 
-/// Union–find over pole indices.
-fn find(parent: &mut [usize], mut i: usize) -> usize {
+/// Union–find root of `i` (path halving).
+pub(crate) fn find(parent: &mut [usize], mut i: usize) -> usize {
     while parent[i] != i {
         parent[i] = parent[parent[i]];
         i = parent[i];

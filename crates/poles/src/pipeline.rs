@@ -14,11 +14,13 @@ use serde::{Deserialize, Serialize};
 
 use crate::drive::Drive;
 use crate::error::{PoleError, Result};
-use crate::extract::{ExtractionStats, extract_poles};
+use crate::extract::{ExtractionStats, extract_poles_from_sweeps};
 use crate::localize::{FilterParams, PoleFilter};
 use crate::mapping::{SlidingWindowFilter, merge_poles, segments};
 use crate::params::PoleParams;
 use crate::pole::Pole;
+use crate::reference::greedy_matches;
+use crate::sweep::SweepMotion;
 
 /// How local maps are laid along the trajectory (spec §3.2).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -150,6 +152,9 @@ pub fn local_maps(
         preset.segments.interval_m,
         preset.segments.length_m,
     );
+    let motions = drive
+        .sweep_timing
+        .map(|timing| SweepMotion::from_poses(track, &drive.stamps_secs, timing));
     let mut totals = ExtractionTotals::default();
     let mut out = Vec::with_capacity(segs.len());
     // Scans of the previous segment are kept (overlapping segments share them).
@@ -164,19 +169,23 @@ pub fn local_maps(
             }
         }
         totals.read_secs += read.elapsed().as_secs_f64();
-        let scans: Vec<(Pose3, &PointCloud)> = wanted
+        // The scans with their sweep motions (when the drive has sweep timing), in step.
+        let (scans, seg_motions): (Vec<(Pose3, &PointCloud)>, Vec<Option<SweepMotion>>) = wanted
             .iter()
             .filter_map(|&i| {
                 let cloud = cache.iter().find(|(j, _)| *j == i).map(|(_, c)| c)?;
-                Some((*track.get(i)?, cloud))
+                let motion = motions.as_ref().and_then(|m| m.get(i).copied());
+                Some(((*track.get(i)?, cloud), motion))
             })
-            .collect();
+            .unzip();
+        let seg_motions: Option<Vec<SweepMotion>> = seg_motions.into_iter().collect();
         let center_index = seg.center + first;
         let center = track
             .get(center_index)
             .map(|p| Point3::from(p.translation()))
             .unwrap_or_else(Point3::origin);
-        let (poles, stats) = extract_poles(&scans, &center, &preset.extraction)?;
+        let (poles, stats) =
+            extract_poles_from_sweeps(&scans, seg_motions.as_deref(), &center, &preset.extraction)?;
         totals.add(&stats);
         out.push(LocalMap {
             scans: wanted,
@@ -404,37 +413,32 @@ pub fn detection_quality(
     truth: &[Point2<f64>],
     radius_m: f64,
 ) -> DetectionQuality {
-    let mut pairs = Vec::new();
-    for (i, d) in detected.iter().enumerate() {
-        for (j, t) in truth.iter().enumerate() {
-            let dist = ((d.x - t.x).powi(2) + (d.y - t.y).powi(2)).sqrt();
-            if dist <= radius_m {
-                pairs.push((dist, i, j));
-            }
+    let d: Vec<(f64, f64)> = detected.iter().map(|p| (p.x, p.y)).collect();
+    let t: Vec<(f64, f64)> = truth.iter().map(|p| (p.x, p.y)).collect();
+    let distances: Vec<f64> = greedy_matches(&d, &t, radius_m)
+        .iter()
+        .map(|m| m.2)
+        .collect();
+    DetectionQuality::from_counts(detected.len(), truth.len(), &distances)
+}
+
+impl DetectionQuality {
+    /// The quality of `detected` detections against `truth` references given the centre
+    /// distances of the matched pairs.
+    pub fn from_counts(detected: usize, truth: usize, matched_distances: &[f64]) -> Self {
+        let matched = matched_distances.len();
+        let ratio = |a: usize, b: usize| if b == 0 { 0.0 } else { a as f64 / b as f64 };
+        Self {
+            detected,
+            truth,
+            matched,
+            precision: ratio(matched, detected),
+            recall: ratio(matched, truth),
+            mean_centre_error_m: if matched == 0 {
+                0.0
+            } else {
+                matched_distances.iter().sum::<f64>() / matched as f64
+            },
         }
-    }
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let (mut used_d, mut used_t) = (vec![false; detected.len()], vec![false; truth.len()]);
-    let (mut matched, mut err) = (0, 0.0);
-    for (dist, i, j) in pairs {
-        if !used_d[i] && !used_t[j] {
-            used_d[i] = true;
-            used_t[j] = true;
-            matched += 1;
-            err += dist;
-        }
-    }
-    let ratio = |a: usize, b: usize| if b == 0 { 0.0 } else { a as f64 / b as f64 };
-    DetectionQuality {
-        detected: detected.len(),
-        truth: truth.len(),
-        matched,
-        precision: ratio(matched, detected.len()),
-        recall: ratio(matched, truth.len()),
-        mean_centre_error_m: if matched == 0 {
-            0.0
-        } else {
-            err / matched as f64
-        },
     }
 }

@@ -19,7 +19,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use nalgebra::{Point2, Point3};
+use nalgebra::{Point2, Point3, Vector3};
 use rand::Rng;
 use raypath_geometry::{PointCloud, Pose3};
 use raypath_io::kitti::{self, KittiLayout};
@@ -62,6 +62,10 @@ pub struct SemiKittiConfig {
     pub labels: bool,
     /// The street scenery.
     pub scenery: Scenery,
+    /// Scan de-skewed sweeps from the moving sensor ([`Lidar3::scan_moving`], the timing of
+    /// KITTI's sweeps; the motion over a sweep from the neighbouring poses) instead of every
+    /// beam from the scan's pose (default false).
+    pub sweep_motion: bool,
 }
 
 impl SemiKittiConfig {
@@ -78,6 +82,7 @@ impl SemiKittiConfig {
             firings: crate::lidar3::HDL64E_FIRINGS_10HZ,
             labels: true,
             scenery: Scenery::default(),
+            sweep_motion: false,
         }
     }
 
@@ -159,6 +164,9 @@ pub struct SemiKittiDrive {
     pub poles_left_out: Vec<usize>,
     /// Length of the trajectory driven (samples every 2 m), metres.
     pub trajectory_length_m: f64,
+    /// The sensor's translation over each scan's sweep (velodyne frame, metres); zero unless
+    /// [`SemiKittiConfig::sweep_motion`].
+    pub sweep_translation_m: Vec<Vector3<f64>>,
     world: World,
     scene: Scene3,
     lidar: Lidar3,
@@ -178,7 +186,18 @@ impl SemiKittiDrive {
         let (world, report) = world_along_path(&samples, &config.poles, &config.scenery, seed);
         let scene = world.build_scene()?;
         let lidar = Lidar3::hdl64e().with_firings(config.firings)?;
+        let sweep_translation_m = frames
+            .iter()
+            .map(|&i| {
+                if config.sweep_motion {
+                    sweep_translation(&world_from_velo, &config.times, i)
+                } else {
+                    Vector3::zeros()
+                }
+            })
+            .collect();
         Ok(Self {
+            sweep_translation_m,
             sequence: config.sequence.clone(),
             world_from_velo: frames.iter().map(|&i| world_from_velo[i]).collect(),
             times_s: frames.iter().map(|&i| config.times[i]).collect(),
@@ -222,8 +241,13 @@ impl SemiKittiDrive {
                 name: "scan",
                 reason: format!("no scan {index} (the drive has {})", self.len()),
             })?;
+        let motion = self
+            .sweep_translation_m
+            .get(index)
+            .copied()
+            .unwrap_or_else(Vector3::zeros);
         self.lidar
-            .scan(&self.scene, pose, self.scan_seed, index as u64)
+            .scan_moving(&self.scene, pose, &motion, self.scan_seed, index as u64)
     }
 
     /// Simulates scan `index` as written to `velodyne/NNNNNN.bin` (and `labels/`): the
@@ -232,6 +256,20 @@ impl SemiKittiDrive {
     pub fn scan(&self, index: usize) -> Result<PointCloud> {
         Ok(returns_only(&self.sim_scan(index)?.cloud))
     }
+}
+
+/// The sensor's translation over one sweep (10 Hz) at frame `i`, in its velodyne frame:
+/// the velocity from the neighbouring frames (central differences, one-sided at the ends).
+fn sweep_translation(world_from_velo: &[Pose3], times: &[f64], i: usize) -> Vector3<f64> {
+    const SWEEP_S: f64 = 0.1;
+    let last = world_from_velo.len().min(times.len()).saturating_sub(1);
+    let (a, b) = (i.saturating_sub(1).min(last), (i + 1).min(last));
+    let dt = times[b] - times[a];
+    if !(dt > 0.0 && dt.is_finite()) {
+        return Vector3::zeros();
+    }
+    let moved = world_from_velo[b].translation() - world_from_velo[a].translation();
+    world_from_velo[i.min(last)].rotation().inverse() * moved * (SWEEP_S / dt)
 }
 
 /// The returns of an organized cloud (finite points), keeping intensity and label.

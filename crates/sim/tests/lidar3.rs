@@ -276,3 +276,49 @@ fn bad_pose_is_an_error() {
     let pose = Pose3::from_xyz_rpy(f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0);
     assert!(Lidar3::hdl32e().scan(&scene, &pose, 0, 0).is_err());
 }
+
+#[test]
+fn moving_sweeps_start_beams_where_the_sensor_was_and_report_in_the_reference_frame() {
+    let scene = floor_and_wall();
+    let lidar = noiseless(Lidar3::hdl64e().with_firings(360).unwrap());
+    let pose = Pose3::from_xyz_rpy(0.0, 0.0, 1.73, 0.0, 0.0, 0.0);
+    // 2 m forward over the sweep: the beams facing forward (middle column) start at the pose,
+    // the first column (the back, half a turn earlier) 1 m behind, the last 1 m ahead.
+    let motion = Vector3::new(2.0, 0.0, 0.0);
+    let moving = lidar.scan_moving(&scene, &pose, &motion, 1, 0).unwrap();
+    let still = lidar.scan(&scene, &pose, 1, 0).unwrap();
+    let mut checked = 0;
+    for row in 0..64 {
+        for col in 0..360 {
+            let i = row * 360 + col;
+            let (el, az) = (lidar.elevations_rad[row], lidar.azimuths_rad[col]);
+            let dir = Vector3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+            let tau = (col as f64 + 0.5) / 360.0 - 0.5;
+            let start = Point3::new(2.0 * tau, 0.0, 1.73);
+            let Some((r, _)) = analytic(&start, &dir).filter(|(r, _)| (0.9..=120.0).contains(r))
+            else {
+                continue;
+            };
+            // The point is the moving origin plus the range, in the frame of the pose.
+            let expected = Vector3::new(2.0 * tau, 0.0, 0.0) + dir * r;
+            let p = moving.cloud.points[i].cast::<f64>();
+            assert!((p.coords - expected).norm() < 1e-3, "row {row} col {col}");
+            assert!((f64::from(moving.true_ranges_m[i]) - r).abs() < 1e-3);
+            checked += 1;
+        }
+    }
+    assert!(checked > 10_000);
+    // Without motion the moving scan is the still one, bit for bit.
+    let zero = lidar
+        .scan_moving(&scene, &pose, &Vector3::zeros(), 1, 0)
+        .unwrap();
+    let bits = |s: &raypath_sim::lidar3::SimScan| -> Vec<u32> {
+        s.cloud
+            .points
+            .iter()
+            .flat_map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+            .chain(s.true_ranges_m.iter().map(|r| r.to_bits()))
+            .collect()
+    };
+    assert_eq!(bits(&zero), bits(&still));
+}

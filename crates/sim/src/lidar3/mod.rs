@@ -32,8 +32,11 @@
 //!    is the sensor model of Schaefer 2020, ch. 11, and matches the real SynPEB sample, whose
 //!    points lie exactly on the nominal grid).
 //!
-//! Intensities follow [`IntensityModel`]. **Motion distortion is ignored**: all beams of a scan
-//! start from one pose, as in de-skewed scans (KITTI's scans are de-skewed too).
+//! Intensities follow [`IntensityModel`]. [`Lidar3::scan`] starts all beams of a scan from one
+//! pose. A de-skewed sweep of a moving sensor, such as KITTI's, holds its points in one frame
+//! but fired each beam from where the sensor was at that moment (0.7 m apart over a sweep at
+//! 25 km/h); [`Lidar3::scan_moving`] simulates that, which matters wherever free space is
+//! traced along the beams.
 //!
 //! ## Determinism and parallelism
 //!

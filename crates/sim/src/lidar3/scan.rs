@@ -67,7 +67,38 @@ impl Lidar3 {
         seed: u64,
         scan_index: u64,
     ) -> Result<SimScan> {
+        self.scan_moving(
+            scene,
+            world_from_sensor,
+            &Vector3::zeros(),
+            seed,
+            scan_index,
+        )
+    }
+
+    /// [`scan`](Self::scan) from a sensor moving by `sweep_translation_m` (sensor frame,
+    /// metres) over the revolution at constant velocity, as a de-skewed sweep: `world_from_sensor`
+    /// is the pose when the sensor faces forward (azimuth 0, the middle column of a rotating
+    /// lidar, which spins clockwise from the back); the beam of a column fired a fraction `τ`
+    /// of a revolution later starts `τ · sweep_translation_m` from there, and its point is
+    /// reported in the sensor frame at that pose (moving origin + measured range along the
+    /// nominal direction), so free space seen by the beam starts where the sensor was — the
+    /// timing of KITTI's de-skewed HDL-64E sweeps. Rotation during the sweep is ignored.
+    pub fn scan_moving(
+        &self,
+        scene: &Scene3,
+        world_from_sensor: &Pose3,
+        sweep_translation_m: &Vector3<f64>,
+        seed: u64,
+        scan_index: u64,
+    ) -> Result<SimScan> {
         self.validate()?;
+        if !sweep_translation_m.iter().all(|v| v.is_finite()) {
+            return Err(SimError::InvalidParameter {
+                name: "sweep_translation_m",
+                reason: "not finite".into(),
+            });
+        }
         if !world_from_sensor.is_finite() {
             return Err(SimError::InvalidParameter {
                 name: "world_from_sensor",
@@ -102,7 +133,13 @@ impl Lidar3 {
                     } else {
                         nominal
                     };
-                    *pixel = self.beam(scene, &origin, &(rotation * cast_dir), &nominal, &mut rng);
+                    // Fraction of a clockwise revolution after facing forward, in [−½, ½).
+                    let turned = -az / std::f64::consts::TAU;
+                    let tau = turned - (turned + 0.5).floor();
+                    let offset = sweep_translation_m * tau;
+                    let start = origin + rotation * offset;
+                    *pixel = self.beam(scene, &start, &(rotation * cast_dir), &nominal, &mut rng);
+                    pixel.point += offset.cast::<f32>();
                 }
             });
 
