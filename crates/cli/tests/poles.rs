@@ -273,3 +273,28 @@ fn bad_input_exits_2_with_file_and_place() {
     ]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// Real KITTI 00 (10 frames): `auto` traces rays from each firing's position, the
+/// SemanticKITTI pole at (4.5, −3.4) m is found either way, and `origin` is honoured.
+#[test]
+fn real_kitti_uses_the_sweep_timing() {
+    let Some(seq) = raypath_io::data::require("kitti/sequences/00") else {
+        return;
+    };
+    let seq = seq.to_str().unwrap();
+    let auto = json_of(&raypath(&["poles", "extract", seq, "--json"]));
+    assert_eq!(auto["sweep_timing"], "kitti");
+    let origin = json_of(&raypath(&[
+        "poles",
+        "extract",
+        seq,
+        "--sweep-timing",
+        "origin",
+        "--json",
+    ]));
+    assert_eq!(origin["sweep_timing"], "origin");
+    for out in [&auto, &origin] {
+        let poles = out["poles"].as_array().unwrap();
+        assert!(nearest(poles, 4.46, -3.42) < 0.3, "{poles:?}");
+    }
+}

@@ -16,7 +16,13 @@
 //!   of the first scan or around `--start x,y,theta`; without ground truth only the final
 //!   estimates are printed (`"summary": null`).
 //!
-//! `--json` prints one document: `extract`/`map` → `{"sequence", "preset", "scans",
+//! `--sweep-timing auto|origin|kitti` says where rays start when local maps are traced:
+//! real KITTI scans are de-skewed sweeps, so by default (`auto`) every ray of a KITTI
+//! sequence starts where the sensor was when it fired it; scans simulated by
+//! `raypath simulate` and bag sweeps start at the scan origin.
+//!
+//! `--json` prints one document (each also with `"sweep_timing"`): `extract`/`map` →
+//! `{"sequence", "preset", "scans",
 //! "local_maps", "poles": [{x, y, width, height, score}], "points_per_sec"}`; `localize` →
 //! `{"sequence", "preset", "runs", "summary": {mean_pos_m, rmse_pos_m, mean_lat_m,
 //! mean_lon_m, mean_ang_deg, rmse_ang_deg, diverged_runs}, "per_run": […]}`.
@@ -78,6 +84,14 @@ pub struct Common {
     /// First scan used.
     #[arg(long, default_value_t = 0, value_name = "I")]
     pub from: usize,
+    /// Where each ray of a scan starts: `kitti` — where the sensor was when it fired the
+    /// ray (KITTI's scans are de-skewed sweeps of a moving, clockwise-turning sensor, cut
+    /// behind it; the motion is taken from the neighbouring poses); `origin` — the scan's
+    /// origin (scans measured from one pose). `auto`: `kitti` for a KITTI sequence, except
+    /// one written by `raypath simulate` (a `set.json` beside `sequences/`), whose scans are
+    /// measured from one pose; `origin` otherwise.
+    #[arg(long, value_enum, default_value_t = SweepTimingArg::Auto)]
+    pub sweep_timing: SweepTimingArg,
     /// Print one JSON document on standard output.
     #[arg(long)]
     pub json: bool,
@@ -87,6 +101,27 @@ pub struct Common {
     /// A Foxglove recording of the run.
     #[command(flatten)]
     pub record: RecordArgs,
+}
+
+/// Values of `--sweep-timing`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SweepTimingArg {
+    /// `kitti` for real KITTI sequences, `origin` otherwise.
+    Auto,
+    /// Rays from the scan's origin.
+    Origin,
+    /// Rays from the sensor's position at each firing, KITTI's sweep timing.
+    Kitti,
+}
+
+/// Whether `sequence` (a KITTI sequence directory) belongs to a set written by
+/// `raypath simulate`: `<set>/sequences/NN` with `<set>/set.json`.
+fn simulated_set(sequence: &std::path::Path) -> bool {
+    sequence
+        .ancestors()
+        .skip(1)
+        .take(2)
+        .any(|dir| dir.join("set.json").is_file())
 }
 
 /// Arguments of `raypath poles extract`.
@@ -152,8 +187,16 @@ pub fn run(args: &Args) -> Result<(), Failure> {
 
 fn open(common: &Common) -> Result<(Drive, Preset, std::ops::Range<usize>), Failure> {
     let json = common.json;
-    let drive = Drive::open_with(&common.sequence, &common.source.sweep_options())
+    let mut drive = Drive::open_with(&common.sequence, &common.source.sweep_options())
         .map_err(|e| Failure::input(e, json))?;
+    let kitti_timing = match common.sweep_timing {
+        SweepTimingArg::Kitti => true,
+        SweepTimingArg::Origin => false,
+        SweepTimingArg::Auto => {
+            drive.format == DriveFormat::Kitti && !simulated_set(&common.sequence)
+        }
+    };
+    drive.sweep_timing = kitti_timing.then(raypath_poles::SweepTiming::kitti);
     let preset = match common.preset.as_deref() {
         Some("nclt") => Preset::nclt(),
         Some("kitti") => Preset::kitti(),
@@ -189,6 +232,14 @@ fn preset_name(common: &Common, drive: &Drive) -> &'static str {
     match (common.preset.as_deref(), drive.format) {
         (Some("nclt"), _) | (None, DriveFormat::Nclt) => "nclt",
         _ => "kitti",
+    }
+}
+
+fn timing_name(drive: &Drive) -> &'static str {
+    if drive.sweep_timing.is_some() {
+        "kitti"
+    } else {
+        "origin"
     }
 }
 
@@ -245,6 +296,7 @@ fn extract(args: &ExtractArgs) -> Result<(), Failure> {
         let mut doc = json!({
             "sequence": c.sequence.display().to_string(),
             "preset": preset_name(c, &drive),
+            "sweep_timing": timing_name(&drive),
             "scans": scans,
             "local_maps": maps.len().min(1),
             "poles": poles_json(&poles),
@@ -283,6 +335,7 @@ fn map(args: &MapArgs) -> Result<(), Failure> {
         let mut doc = json!({
             "sequence": c.sequence.display().to_string(),
             "preset": preset_name(c, &drive),
+            "sweep_timing": timing_name(&drive),
             "scans": scans,
             "local_maps": maps.len(),
             "poles": poles_json(&poles),
@@ -409,6 +462,7 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
         "sequence": c.sequence.display().to_string(),
         "map": args.map.display().to_string(),
         "preset": preset_name(c, &drive),
+            "sweep_timing": timing_name(&drive),
         "runs": args.runs,
         "summary": null,
     });
