@@ -132,3 +132,29 @@ fn kitti_sequence_round_trips_through_a_bag() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("CARMEN"));
 }
+
+/// An Ouster capture with vendor poses becomes a KITTI sequence: one scan per frame with
+/// every valid return (no NaN no-returns), the poses and the frame times.
+#[test]
+fn ouster_capture_converts_to_kitti() {
+    let Some(pcap) = raypath_io::data::require("ouster/OS-1-128_v2.3.0_1024x10_lb_n3.pcap") else {
+        return;
+    };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("kitti");
+    let report = json_of(&raypath(&["convert", s(&pcap), s(&out), "--json"]));
+    assert_eq!(report["from"], "ouster-pcap");
+    assert_eq!(report["frames"], 3);
+    assert_eq!(report["reference_poses"], 3);
+    let sequence = raypath_io::sequence::SweepSequence::open(
+        &pcap,
+        &raypath_io::sequence::SweepOptions::default(),
+    )
+    .expect("capture");
+    let info = json_of(&raypath(&["info", s(&out), "--json"]));
+    let valid: usize = (0..3)
+        .map(|k| sequence.sweep(k).expect("sweep").num_valid())
+        .sum();
+    assert_eq!(info["points"].as_u64(), Some(valid as u64));
+    assert_eq!(info["poses"], 3);
+}

@@ -1,4 +1,4 @@
-//! Conversion between CARMEN logs, the KITTI layout, PCD files and rosbag2 recordings
+//! Conversion between CARMEN logs, the KITTI layout, Ouster captures, PCD files and rosbag2 recordings
 //! (`raypath convert <in> <out>`), so the public benchmark logs become bags and back.
 //!
 //! | from \ to | CARMEN | KITTI layout | PCD | rosbag2 |
@@ -7,6 +7,7 @@
 //! | rosbag2 with LaserScan | ✓ | | | ✓ (topic choice) |
 //! | KITTI sequence / NCLT session | | ✓ | one file per sweep | PointCloud2 + tf + reference |
 //! | rosbag2 with PointCloud2 | | ✓ | one file per sweep | ✓ |
+//! | Ouster capture (`.pcap` + metadata JSON) | | ✓ | one file per frame | PointCloud2 + tf + reference |
 //! | PCD file | | one frame | ✓ | one PointCloud2 |
 //!
 //! * **CARMEN out**: `FLASER` lines when a scan's beams follow the default fan of its beam
@@ -152,9 +153,9 @@ fn unsupported(path: &Path, reason: String) -> Error {
 fn read_input(input: &Path, format: Format, options: &ConvertOptions) -> Result<Input> {
     match format {
         Format::Carmen => Ok(Input::Planar(read_planar(input, &options.planar)?)),
-        Format::KittiSequence | Format::NcltSession => Ok(Input::Spatial(Box::new(
-            SweepSequence::open(input, &options.sweeps)?,
-        ))),
+        Format::KittiSequence | Format::NcltSession | Format::OusterPcap => Ok(Input::Spatial(
+            Box::new(SweepSequence::open(input, &options.sweeps)?),
+        )),
         Format::Pcd => {
             let pcd = pcd::read_pcd(input, &pcd::ReadOptions::default())?;
             let cloud = pcd.cloud;
@@ -173,7 +174,7 @@ fn read_input(input: &Path, format: Format, options: &ConvertOptions) -> Result<
             input,
             format!(
                 "{} files cannot be converted; inputs are CARMEN logs, KITTI sequences, NCLT \
-                 sessions, PCD files and rosbag2 recordings",
+                 sessions, Ouster captures (.pcap), PCD files and rosbag2 recordings",
                 other.name()
             ),
         )),

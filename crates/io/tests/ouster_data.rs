@@ -250,6 +250,7 @@ fn capture_as_sweep_sequence() {
     };
     let sequence = SweepSequence::open(&pcap, &SweepOptions::default()).unwrap();
     assert_eq!(sequence.len(), 3);
+    assert_eq!(sequence.format, raypath_io::sequence::SweepFormat::Ouster);
     let poses = sequence.require_reference().unwrap();
     assert!(poses[0].translation().norm() < 1e-9);
     let step = (poses[1].translation() - poses[0].translation()).norm();

@@ -45,7 +45,7 @@ impl DriveFormat {
     pub fn of(format: SweepFormat) -> Self {
         match format {
             SweepFormat::Nclt => DriveFormat::Nclt,
-            SweepFormat::Kitti | SweepFormat::Bag => DriveFormat::Kitti,
+            SweepFormat::Kitti | SweepFormat::Bag | SweepFormat::Ouster => DriveFormat::Kitti,
         }
     }
 
@@ -128,6 +128,12 @@ impl Drive {
             })?,
             (None, SweepFormat::Bag) => ground_truth.clone().ok_or_else(|| {
                 missing("the bag has neither odometry nor reference poses for every sweep")
+            })?,
+            (None, SweepFormat::Ouster) => ground_truth.clone().ok_or_else(|| {
+                missing(
+                    "the Ouster capture has no poses for its frames (<capture stem>_poses_kitti.txt \
+                     beside the .pcap)",
+                )
             })?,
         };
         Ok(Self {

@@ -1,5 +1,6 @@
-//! `raypath convert`: between CARMEN logs, the KITTI layout, PCD files and rosbag2 bags, so
-//! the public benchmark logs become bags and back (`raypath_io::convert`).
+//! `raypath convert`: between CARMEN logs, the KITTI layout, PCD files and rosbag2 bags, and
+//! from Ouster captures, so the public benchmark logs become bags and back
+//! (`raypath_io::convert`).
 
 use std::path::PathBuf;
 
@@ -24,8 +25,9 @@ pub enum Compression {
 /// Arguments of `raypath convert`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The input: a CARMEN log, a KITTI sequence, an NCLT session, a PCD file, or a rosbag2
-    /// bag (a directory with metadata.yaml, or an .mcap file).
+    /// The input: a CARMEN log, a KITTI sequence, an NCLT session, an Ouster capture (.pcap
+    /// with its metadata JSON beside it), a PCD file, or a rosbag2 bag (a directory with
+    /// metadata.yaml, or an .mcap file).
     pub input: PathBuf,
     /// The output: `.mcap` (a rosbag2 file), `.log`/`.clf` (CARMEN), `.pcd`, or a directory
     /// (KITTI layout for 3-D input, a rosbag2 bag directory for planar input); `--to` decides

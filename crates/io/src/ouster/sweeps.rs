@@ -26,8 +26,8 @@ pub fn poses_path(pcap: &Path) -> Option<PathBuf> {
 ///
 /// With a [`poses_path`] file, its poses (KITTI 3 × 4 layout, one per frame) are taken as
 /// `world_from_sensor` of each sweep, for both the reference and the odometry tracks (as for
-/// KITTI, which has no separate odometry). Until the sweep formats name Ouster captures, the
-/// sequence reports [`crate::sequence::SweepFormat::Bag`], the other file-backed recording.
+/// KITTI, which has no separate odometry). The sequence reports
+/// [`crate::sequence::SweepFormat::Ouster`].
 ///
 /// Sweeps are read on demand: an uncompressed capture is re-opened at the frame's first
 /// packet; a compressed one is read from the start.
@@ -96,6 +96,7 @@ pub fn open_sweeps(pcap: &Path) -> Result<SweepSequence> {
     };
     SweepSequence::from_reader(
         pcap.to_path_buf(),
+        crate::sequence::SweepFormat::Ouster,
         stamps,
         reference.clone(),
         reference,

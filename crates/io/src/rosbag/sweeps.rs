@@ -166,6 +166,7 @@ pub fn open_sweeps(path: &Path, topics: &Topics) -> Result<SweepSequence> {
     };
     SweepSequence::from_reader(
         bag.path,
+        crate::sequence::SweepFormat::Bag,
         stamps,
         reference,
         odometry,

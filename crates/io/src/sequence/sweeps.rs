@@ -20,6 +20,8 @@ pub enum SweepFormat {
     Nclt,
     /// A rosbag2 recording (`sensor_msgs/msg/PointCloud2`).
     Bag,
+    /// An Ouster capture (`.pcap` with the sensor's metadata JSON).
+    Ouster,
 }
 
 /// The error a sweep function of an in-memory sequence may return.
@@ -151,6 +153,7 @@ impl SweepSequence {
 
     pub(crate) fn from_reader(
         name: PathBuf,
+        format: SweepFormat,
         stamps_secs: Vec<f64>,
         reference: Option<Vec<Pose3>>,
         odometry: Option<Vec<Pose3>>,
@@ -158,7 +161,7 @@ impl SweepSequence {
     ) -> Result<Self> {
         Self::from_parts(
             name,
-            SweepFormat::Bag,
+            format,
             stamps_secs,
             reference,
             odometry,

@@ -198,6 +198,7 @@ fn read_sweeps(path: &Path, sequence: SweepSequence) -> Input {
         SweepFormat::Kitti => "KITTI velodyne scans",
         SweepFormat::Nclt => "NCLT velodyne scans",
         SweepFormat::Bag => "PointCloud2 sweeps",
+        SweepFormat::Ouster => "Ouster sweeps",
     };
     let labels = frame_numbers(&sequence);
     let poses = sweep_poses(&sequence).map(|(poses, _)| poses.iter().copied().map(Some).collect());
