@@ -385,6 +385,11 @@ fn report_markdown(
     md.push_str(&table.to_markdown());
 
     md.push_str("\n## Table 7.2 analogue: simulated 3-D urban drive (6-DOF)\n\n");
+    md.push_str(
+        &super::sim::gap_note(ctx)
+            .unwrap_or_else(|e| format!("(How far the simulation is from real scans: {e:#})\n")),
+    );
+    md.push('\n');
     md.push_str(&format!(
         "{} particles, {} rays per scan (subsampled), 0.5 m voxels, map from the even frames ({map_rays_3d} rays), \
          localization on {frames_3d} odd frames; motion = ground-truth increments through the 6-DOF Gaussian model; \

@@ -603,6 +603,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         "\n## Summary of the earlier sets (beam-based, r = 0.2 m, M = 8; urban and geb079 are \
          simulated)\n"
     )?;
+    writeln!(md, "{}", super::sim::gap_note(ctx)?)?;
     let mut summary = Table::new(["quantity", "measured", "thesis / aim"]);
     summary.row([
         format!(

@@ -206,6 +206,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         writeln!(md, "* {vocabulary_note}\n")?;
     }
     writeln!(md, "## 3. Semi-synthetic KITTI with real trajectories\n")?;
+    writeln!(md, "{}", super::sim::gap_note(ctx)?)?;
     let s3 = if wanted("3") {
         semi_kitti::run(ctx, vocabulary.as_ref())?
     } else {

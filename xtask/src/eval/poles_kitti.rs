@@ -395,7 +395,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          localization on the same drive as in the thesis: 2000 particles, 3 m / ±5° initial \
          spread, 2 % odometry noise, 50 runs (†: {LONG_RUNS} runs on sequences of more than \
          {FULL_RUNS_MAX_SCANS} scans, for the time budget), errors every 1 m of ground-truth \
-         arc length (means over runs). {realism}{}\n",
+         arc length (means over runs). {realism}{}\n\n{}",
         if ctx.quick {
             "07 and 06"
         } else {
@@ -408,6 +408,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         } else {
             ""
         },
+        super::sim::gap_note(ctx)?,
     )?;
     writeln!(
         md,

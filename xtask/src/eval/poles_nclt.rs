@@ -525,7 +525,8 @@ fn report(
          removed / moved / added, cumulative: a removed pole stays removed), parked cars, \
          construction zones with barrels, leaf factor of the crowns. The quarter-window shift of \
          the session plan makes the reference map cover the first session's window and the \
-         new quarters of the later ones.\n\n{}",
+         new quarters of the later ones.\n\n{}\n{}",
+        super::sim::gap_note(ctx)?,
         sessions_table(campus).to_markdown()
     )?;
     writeln!(

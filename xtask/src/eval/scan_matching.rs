@@ -14,12 +14,16 @@
 //! * **Calibration on real scans**: the same LUT fitted on the road class of the real,
 //!   SemanticKITTI-labelled KITTI frames and scored by the coefficient of variation per class
 //!   on held-back frames ([`real_calib`]).
+//! * **Calibration on real Ouster frames**: the LUT fitted on the ground of the real Ouster
+//!   captures, on the raw signal and on the sensor's reflectivity, scored on held-back
+//!   columns ([`real_ouster`]).
 //! * **Failure case** (simulated, Khan Fig. 3.6): 8.5 m × 5.5 m room with reflectivity
 //!   panels, ±60° field of view, stops facing single walls; occupancy, reflectivity and
 //!   combined residuals scored against ground truth (and a 180° control).
 //! * **Speed**: scans per second of each run (release build, one thread, machine shared).
 
 mod real_calib;
+mod real_ouster;
 mod sim;
 
 use std::fmt::Write;
@@ -712,12 +716,14 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         );
     }
     let _ = writeln!(md, "## Intensity calibration (simulated, Khan Fig. 3.4)\n");
+    let _ = writeln!(md, "{}", super::sim::gap_note(ctx)?);
     let (calibration, lut) = run_calibration(ctx, &mut md)?;
     let _ = writeln!(
         md,
         "## Intensity calibration on real KITTI scans (real, Khan Fig. 3.4 in real form)\n"
     );
     let real_calibration = real_calib::run(ctx, &mut md)?;
+    let ouster_calibration = real_ouster::run(ctx, &mut md)?;
     let _ = writeln!(md, "## Failure case (simulated, Khan Fig. 3.6)\n");
     let failure = run_failure_case(ctx, &mut md, &lut)?;
     let _ = writeln!(
@@ -729,6 +735,6 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         name: NAME,
         title: "Intensity calibration and Hector-style scan matching (Khan ch. 3)".into(),
         markdown: md,
-        json: json!({ "real": real, "calibration": calibration, "real_calibration": real_calibration, "failure_case": failure, "generated_lab": generated }),
+        json: json!({ "real": real, "calibration": calibration, "real_calibration": real_calibration, "ouster_calibration": ouster_calibration, "failure_case": failure, "generated_lab": generated }),
     })
 }

@@ -3,6 +3,8 @@
 
 mod realism;
 
+pub use realism::gap_note;
+
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};

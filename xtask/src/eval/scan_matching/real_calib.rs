@@ -41,7 +41,7 @@ const BIN_ANGLE_DEG: f64 = 2.0;
 const BIN_MIN_SAMPLES: usize = 10;
 
 /// The mean sample of each (r, α) bin holding at least [`BIN_MIN_SAMPLES`] samples.
-fn binned_means(samples: &[CalibrationSample]) -> Vec<CalibrationSample> {
+pub(super) fn binned_means(samples: &[CalibrationSample]) -> Vec<CalibrationSample> {
     let mut bins: std::collections::BTreeMap<(i64, i64), (CalibrationSample, usize)> =
         Default::default();
     for s in samples {
