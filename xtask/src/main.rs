@@ -11,6 +11,7 @@
 mod datasets;
 mod eval;
 mod generate;
+mod readme;
 mod render;
 mod stats;
 mod table;

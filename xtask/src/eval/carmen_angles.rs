@@ -250,6 +250,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             title: "CARMEN beam-angle convention (skipped: no data)".into(),
             markdown: message,
             json: json!({ "skipped": true }),
+            headline: None,
         });
     }
     let stride = if ctx.quick { QUICK_STRIDE } else { 1 };
@@ -512,5 +513,6 @@ fn report(results: &[LogResult], pictures: &[(String, String)], stride: usize) -
             "winner_odd_beams": odd_name,
             "logs": json_logs,
         }),
+        headline: None,
     }
 }

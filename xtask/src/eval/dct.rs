@@ -279,6 +279,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             title: "Continuous DCT decay-rate maps against grid maps (Tables 9.2-9.4)".into(),
             markdown: md,
             json: json!({ "status": "skipped: no data" }),
+            headline: None,
         });
     }
     let load_before = load_average();
@@ -321,6 +322,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         title: "Continuous DCT decay-rate maps against grid maps (Tables 9.2-9.4)".into(),
         markdown: md,
         json: json!({ "logs": infos, "results": json_cells, "quick": ctx.quick, "threads": rayon::current_num_threads() }),
+        headline: None,
     })
 }
 

@@ -409,5 +409,6 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             "load_average_after": load_after,
             "cases": json_cases,
         }),
+        headline: None,
     })
 }

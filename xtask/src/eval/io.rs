@@ -207,5 +207,6 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         title: "I/O: every file under RAYPATH_DATA, read by raypath-io".into(),
         markdown,
         json,
+        headline: None,
     })
 }

@@ -264,6 +264,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         title: "Monte-Carlo localization per sensor model".to_owned(),
         markdown,
         json,
+        headline: None,
     })
 }
 

@@ -80,6 +80,10 @@ pub struct EvalReport {
     pub markdown: String,
     /// Machine-readable results.
     pub json: serde_json::Value,
+    /// The run's figures in one line, real rows first (simulated ones named so): written at
+    /// the top of the results page and, after a full run, into the README's crate map
+    /// ([`crate::readme`]).
+    pub headline: Option<String>,
 }
 
 type EvalFn = fn(&EvalContext) -> Result<EvalReport>;
@@ -231,7 +235,12 @@ fn write_report(ctx: &EvalContext, report: &EvalReport, seconds: f64) -> Result<
         machine(),
         ctx.data_dir.display(),
     );
-    let markdown = format!("{header}{}", report.markdown.trim_end());
+    let headline = match &report.headline {
+        Some(text) if ctx.quick => format!("**Headline (quick run).** {text}\n\n"),
+        Some(text) => format!("{}{text}\n\n", crate::readme::PREFIX),
+        None => String::new(),
+    };
+    let markdown = format!("{header}{headline}{}", report.markdown.trim_end());
     println!("{markdown}\n");
 
     let docs = ctx.workspace_root.join("docs/results");
@@ -257,6 +266,9 @@ fn write_report(ctx: &EvalContext, report: &EvalReport, seconds: f64) -> Result<
     std::fs::write(&json_path, serde_json::to_string_pretty(&json)?)
         .with_context(|| format!("writing {}", json_path.display()))?;
     eprintln!("wrote {} and {}", md_path.display(), json_path.display());
+    if let (Some(text), false) = (&report.headline, ctx.quick) {
+        crate::readme::update(&ctx.workspace_root, report.name, text)?;
+    }
     Ok(())
 }
 

@@ -740,10 +740,12 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         "runs": rows,
         "variants": variant_rows,
     });
+    let headline = real::headline(&real_rows, reduction_02.as_ref());
     Ok(EvalReport {
         name: NAME,
         title: "Rtree variable-resolution grid beside OctoMap (Khan ch. 2)".into(),
         markdown: md,
         json,
+        headline,
     })
 }

@@ -248,5 +248,21 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             "thesis_table_4_2": s5,
             "summary": summary,
         }),
+        headline: {
+            // Real sections first (3-D, then 2-D), then speed; the semi-synthetic lines stay
+            // on the page.
+            let lines: Vec<&String> = [&s2, &s1, &s4]
+                .iter()
+                .flat_map(|s| s.summary.iter())
+                .collect();
+            (!lines.is_empty()).then(|| {
+                lines
+                    .iter()
+                    .map(|l| l.trim_end_matches('.'))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+                    + "."
+            })
+        },
     })
 }

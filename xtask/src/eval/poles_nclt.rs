@@ -159,6 +159,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             })),
             "elapsed_s": total_secs,
         }),
+        headline: None,
     })
 }
 

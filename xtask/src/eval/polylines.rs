@@ -881,6 +881,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
                 .into(),
         markdown: md,
         json,
+        headline: None,
     })
 }
 

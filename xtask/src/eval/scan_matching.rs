@@ -736,5 +736,68 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         title: "Intensity calibration and Hector-style scan matching (Khan ch. 3)".into(),
         markdown: md,
         json: json!({ "real": real, "calibration": calibration, "real_calibration": real_calibration, "ouster_calibration": ouster_calibration, "failure_case": failure, "generated_lab": generated }),
+        headline: headline(&real, &real_calibration, &ouster_calibration),
     })
+}
+
+/// The page's headline: Hector-style matching on the real logs, then the intensity
+/// calibration on the real KITTI and Ouster frames.
+fn headline(real: &Value, kitti: &Value, ouster: &Value) -> Option<String> {
+    let logs: Vec<String> = real
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter(|r| r["method"] == "Hector, odometry prior")
+        .filter_map(|r| {
+            let t = r["errors"]["relative"]["translation_m"]["mean"].as_f64()?;
+            let a = r["errors"]["relative"]["rotation_rad"]["mean"].as_f64()?;
+            Some(format!(
+                "{} {:.3} m / {:.2}°",
+                r["log"].as_str()?,
+                t,
+                a.to_degrees()
+            ))
+        })
+        .collect();
+    let mut parts = Vec::new();
+    if !logs.is_empty() {
+        parts.push(format!(
+            "Real logs, Hector-style matching with odometry prior, mean relative error: {}",
+            logs.join(", ")
+        ));
+    }
+    let cv = |rows: &Value, model: &str| -> Vec<f64> {
+        rows.as_array()
+            .into_iter()
+            .flatten()
+            .find(|r| r["model"] == model)
+            .and_then(|r| r["cv"].as_array())
+            .map(|v| v.iter().filter_map(Value::as_f64).collect())
+            .unwrap_or_default()
+    };
+    let rows = &kitti["models_covered_only"];
+    let (raw, lut) = (cv(rows, "raw"), cv(rows, "lut"));
+    if !raw.is_empty() && raw.len() == lut.len() {
+        parts.push(format!(
+            "real KITTI intensity calibration (LUT fitted on the road): lower CV than the raw \
+             reflectance for {} of {} classes",
+            raw.iter().zip(&lut).filter(|(r, l)| l < r).count(),
+            raw.len()
+        ));
+    }
+    let ground: Vec<String> = ouster["rows"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter(|r| r["channel"] == "signal")
+        .filter_map(|r| Some((r["model"].as_str()?, r["cv"].as_f64()?)))
+        .map(|(model, cv)| format!("{model} {cv:.2}"))
+        .collect();
+    if !ground.is_empty() {
+        parts.push(format!(
+            "real Ouster raw signal, CV on held-back ground: {}",
+            ground.join(", ")
+        ));
+    }
+    (!parts.is_empty()).then(|| format!("{}.", parts.join("; ")))
 }

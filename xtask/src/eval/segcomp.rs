@@ -119,6 +119,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             title: "PPE on SegComp Perceptron (Schaefer 2020, Table 11.1)".into(),
             markdown,
             json: serde_json::json!({"missing": true, "data_dir": dir.display().to_string()}),
+            headline: None,
         });
     }
     if ctx.quick {
@@ -229,5 +230,6 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         markdown,
         json: serde_json::json!({"missing": false, "scans": rows.len(), "f": mean(1), "k": mean(2),
             "rmse_mm": mean(3), "alpha_deg": mean(4), "n_o": mean(5), "n_u": mean(6), "n_m": mean(7), "n_s": mean(8)}),
+        headline: None,
     })
 }

@@ -274,6 +274,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             .to_owned(),
         markdown,
         json,
+        headline: None,
     })
 }
 

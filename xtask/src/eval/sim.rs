@@ -144,6 +144,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         title: "Simulated data sets: contents, statistics and pictures".into(),
         markdown: md,
         json,
+        headline: None,
     })
 }
 

@@ -499,5 +499,6 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         title: "2-D SLAM on the SLAM-benchmark logs (raypath-slam)".into(),
         markdown: md,
         json: json!({ "referenced": rows, "unreferenced": loops, "residual_ablation": ablation }),
+        headline: None,
     })
 }

@@ -96,3 +96,52 @@ pub fn table(sets: &[Dataset], rows: &[Value], variants: &[Value]) -> (Table, Ve
     }
     (table, json_rows)
 }
+
+/// `lo to hi` of `values` with `digits` decimals (one value when they round alike).
+pub fn span(values: &[f64], digits: usize) -> String {
+    let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !lo.is_finite() {
+        return "—".into();
+    }
+    let (a, b) = (fmt_num(lo, digits), fmt_num(hi, digits));
+    if a == b { a } else { format!("{a} to {b}") }
+}
+
+/// The results page's headline: the real rows (ranges over the real data sets), then the
+/// simulated set of the earlier summary.
+pub fn headline(real_rows: &[Value], simulated: Option<&(String, f64)>) -> Option<String> {
+    if real_rows.is_empty() {
+        return None;
+    }
+    let values = |path: &[&str], scale: f64| -> Vec<f64> {
+        real_rows
+            .iter()
+            .filter_map(|r| path.iter().fold(r, |v, k| &v[*k]).as_f64())
+            .map(|v| v * scale)
+            .collect()
+    };
+    let names: Vec<&str> = real_rows
+        .iter()
+        .filter_map(|r| r["data"].as_str())
+        .collect();
+    let simulated = simulated.map_or(String::new(), |(name, v)| {
+        format!(
+            "; simulated `{name}`: thesis rule {} % fewer leaves",
+            fmt_num(100.0 * v, 1)
+        )
+    });
+    Some(format!(
+        "Real scans ({}; r = 0.2 m, M = 8, OctoMap 1.9 in the same run): the thesis' fusion \
+         rule gives {} % fewer leaves than pruned OctoMap at {}× its insertion time; \
+         equal-value fusion {} % fewer leaves at {}× the insertion time and {}× the bytes \
+         (negative: more leaves){simulated}. Not like for like with the thesis' 28.5 % \
+         (its Freiburg campus graph is not available).",
+        names.join(", "),
+        span(&values(&["leaf_reduction"], 100.0), 1),
+        span(&values(&["insertion_time_ratio"], 1.0), 2),
+        span(&values(&["equal_value", "leaf_reduction"], 100.0), 1),
+        span(&values(&["equal_value", "insertion_time_ratio"], 1.0), 2),
+        span(&values(&["equal_value", "bytes_ratio"], 1.0), 2),
+    ))
+}

@@ -253,9 +253,19 @@ fn run_sequence(
     }))
 }
 
-/// The real section: markdown, JSON, and one sentence on how far the simulation is from the
-/// real frames (for the semi-synthetic part of the report).
-pub(super) fn section(ctx: &EvalContext, params: &PoleParams) -> Result<(String, Value, String)> {
+/// The real section's outputs.
+pub(super) struct Section {
+    pub markdown: String,
+    pub json: Value,
+    /// One sentence on how far the simulation is from the real frames (for the
+    /// semi-synthetic part of the report).
+    pub realism: String,
+    /// The real half of the page's headline.
+    pub headline: Option<String>,
+}
+
+/// The real section.
+pub(super) fn section(ctx: &EvalContext, params: &PoleParams) -> Result<Section> {
     let rule = ReferenceRule::default();
     let mut notes = Vec::new();
     let mut results = Vec::new();
@@ -302,5 +312,10 @@ pub(super) fn section(ctx: &EvalContext, params: &PoleParams) -> Result<(String,
         "totals": totals,
         "notes": notes,
     });
-    Ok((markdown, value, render::realism(&results)))
+    Ok(Section {
+        markdown,
+        json: value,
+        realism: render::realism(&results),
+        headline: render::headline(&results),
+    })
 }
