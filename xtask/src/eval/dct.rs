@@ -546,6 +546,8 @@ fn report_markdown(
         "RMSE GM",
         "LL DCT",
         "LL GM",
+        "worst-ray LL DCT",
+        "worst-ray LL GM",
         "t_DCT(10⁴) [s]",
         "iterations",
     ]);
