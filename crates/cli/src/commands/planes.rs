@@ -1,10 +1,11 @@
 //! `raypath planes`: maximum-likelihood finite planes (PPE; Schaefer 2020 ch. 11) from an
 //! organized PCD scan, in the sensor frame (every ray starts at the origin).
 //!
-//! The scan is a PCD file, or one sweep of a rosbag2 bag (its directory with
-//! `metadata.yaml`, or its `.mcap` file): sweep `--frame-index` (default 0) of its
-//! `sensor_msgs/msg/PointCloud2` topic, read through `raypath_io::sequence::SweepSequence`;
-//! the cloud must be organized (height > 1, NaN = no return).
+//! The scan is a PCD file, one sweep of a rosbag2 bag (its directory with `metadata.yaml`,
+//! or its `.mcap` file; its `sensor_msgs/msg/PointCloud2` topic) or one frame of an Ouster
+//! capture (`.pcap` with its metadata JSON; the organized first-return cloud): sweep
+//! `--frame-index` (default 0), read through `raypath_io::sequence::SweepSequence`; the cloud
+//! must be organized (height > 1, NaN = no return).
 //!
 //! `--method ppe|msac|peac` picks PPE (default), the iterative MSAC baseline or the
 //! PEAC-style block-graph baseline (Feng et al. 2014); `--preset` applies to PPE (the
@@ -42,10 +43,11 @@ use super::source_args::{SourceArgs, is_bag};
 /// Arguments of `raypath planes`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// An organized PCD scan (width × height, NaN = no return), or a rosbag2 bag (directory
-    /// with metadata.yaml, or .mcap file) with organized PointCloud2.
+    /// An organized PCD scan (width × height, NaN = no return), a rosbag2 bag (directory
+    /// with metadata.yaml, or .mcap file) with organized PointCloud2, or an Ouster capture
+    /// (.pcap with its metadata JSON beside it).
     pub scan: PathBuf,
-    /// Bags: the 0-based index of the sweep to use.
+    /// Bags and Ouster captures: the 0-based index of the sweep (frame) to use.
     #[arg(long, default_value_t = 0, value_name = "I")]
     pub frame_index: usize,
     /// Extraction method: ppe (default), msac or peac.
@@ -75,10 +77,11 @@ pub struct Args {
     pub record: RecordArgs,
 }
 
-/// The organized scan and its time: a PCD file (time 0), or sweep `--frame-index` of a bag.
+/// The organized scan and its time: a PCD file (time 0), or sweep `--frame-index` of a bag
+/// or an Ouster capture.
 fn read_scan(args: &Args) -> Result<(PointCloud, f64), Failure> {
     let bad = |e: raypath_io::Error| Failure::input(e, args.json);
-    if !is_bag(&args.scan) {
+    if !is_bag(&args.scan) && !raypath_io::ouster::is_capture_name(&args.scan) {
         let options = ReadOptions {
             label_from: raypath_io::pcd::LabelSource::None,
         };
@@ -88,7 +91,7 @@ fn read_scan(args: &Args) -> Result<(PointCloud, f64), Failure> {
     if args.frame_index >= sequence.len() {
         return Err(Failure::input(
             format!(
-                "{}: --frame-index {} but the bag has {} sweep(s)",
+                "{}: --frame-index {} but it has {} sweep(s)",
                 sequence.name.display(),
                 args.frame_index,
                 sequence.len()
