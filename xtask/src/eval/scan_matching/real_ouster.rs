@@ -134,6 +134,7 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
         "Spearman with sensor reflectivity",
     ]);
     let mut rows = Vec::new();
+    let mut notes = Vec::new();
     for (file, sensor) in CAPTURES {
         let pcap = ctx.data(&format!("ouster/{file}"));
         if !pcap.is_file() {
@@ -174,7 +175,12 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
         for (channel, split) in &channels {
             let reference = binned_means(&split.fit);
             if reference.len() < 3 || split.held.is_empty() {
-                eprintln!("scan-matching: too little ground in {file} for {channel}, skipping");
+                notes.push(format!(
+                    "{sensor}: too little ground for the {channel} channel ({} ground returns \
+                     in the fit columns, {} (r, α) bins); left out.",
+                    split.fit.len(),
+                    reference.len()
+                ));
                 continue;
             }
             let table_lut = IntensityLut::fit(&reference, &LutConfig::default())?;
@@ -242,5 +248,37 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
          asphalt, paint and grass in one scene add spread no (r, α) model removes.\n\n{}",
         table.to_markdown()
     );
-    Ok(json!({ "rows": rows }))
+    for note in &notes {
+        let _ = writeln!(md, "* {note}");
+    }
+    if let Some(finding) = signal_finding(&rows) {
+        let _ = writeln!(md, "\n{finding}\n");
+    }
+    Ok(json!({ "rows": rows, "notes": notes }))
+}
+
+/// One sentence on the signal channel: what the corrections do to its spread, its range
+/// dependence and its agreement with the sensor's reflectivity.
+fn signal_finding(rows: &[Value]) -> Option<String> {
+    let row = |model: &str| {
+        rows.iter()
+            .find(|r| r["channel"] == "signal" && r["model"] == model)
+    };
+    let (raw, range, lut) = (row("raw")?, row("range")?, row("lut")?);
+    let f = |r: &Value, key: &str| r[key].as_f64().unwrap_or(f64::NAN);
+    Some(format!(
+        "On the ground of the capture with a signal channel, the LUT changes the raw \
+         signal's CV from {:.2} to {:.2} (range-only polynomial: {:.2}) and its rank \
+         correlation with range from {:.2} to {:.2}; its rank agreement with the sensor's \
+         reflectivity goes from {:.2} to {:.2}. The sensor's reflectivity is not a ground \
+         truth here: its own rank correlation with range on this ground is in the \
+         reflectivity rows.",
+        f(raw, "cv"),
+        f(lut, "cv"),
+        f(range, "cv"),
+        f(raw, "spearman_range"),
+        f(lut, "spearman_range"),
+        f(raw, "spearman_reflectivity"),
+        f(lut, "spearman_reflectivity"),
+    ))
 }
