@@ -85,6 +85,28 @@ fn missing_input(set: &SetSpec) -> Option<String> {
     })
 }
 
+/// How long generating a set took: beside `set.json`, not in it, so that the same seed gives
+/// the same bytes in every file the set lists and in `set.json` itself.
+pub const TIMING_FILE: &str = "timing.json";
+/// The bookkeeping files of a set, not listed in it.
+const BOOKKEEPING: [&str; 3] = ["SHA256SUMS", "set.json", TIMING_FILE];
+/// Statistics keys that are measured times, not properties of the data.
+const TIMING_KEYS: [&str; 2] = ["elapsed_s", "rays_per_s"];
+
+/// Removes the timing keys from `stats` and returns them with the whole run's seconds.
+fn take_timing(stats: &mut serde_json::Value, total_s: f64) -> serde_json::Value {
+    let mut timing = serde_json::Map::new();
+    if let Some(object) = stats.as_object_mut() {
+        for key in TIMING_KEYS {
+            if let Some(value) = object.remove(key) {
+                timing.insert(key.to_owned(), value);
+            }
+        }
+    }
+    timing.insert("total_s".to_owned(), serde_json::json!(total_s));
+    serde_json::Value::Object(timing)
+}
+
 struct SetInfo {
     quick: bool,
 }
@@ -98,7 +120,12 @@ fn read_set_info(dir: &Path) -> Option<SetInfo> {
 }
 
 fn generate(set: &SetSpec, quick: bool, seed: u64) -> Result<()> {
-    let root = generated_root();
+    generate_into(&generated_root(), set, quick, seed)
+}
+
+/// Generates `set` into `root/<name>` (through a partial directory renamed at the end).
+fn generate_into(root: &Path, set: &SetSpec, quick: bool, seed: u64) -> Result<()> {
+    let root = root.to_path_buf();
     std::fs::create_dir_all(&root).with_context(|| format!("creating {}", root.display()))?;
     let final_dir = root.join(set.name);
     let work_dir = root.join(format!(".{}.partial", set.name));
@@ -136,6 +163,12 @@ fn generate(set: &SetSpec, quick: bool, seed: u64) -> Result<()> {
         entries.push(serde_json::json!({"path": relative.display().to_string(), "bytes": bytes, "sha256": digest}));
     }
     std::fs::write(work_dir.join("SHA256SUMS"), &sums)?;
+    let mut stats = generated.stats;
+    let timing = take_timing(&mut stats, started.elapsed().as_secs_f64());
+    std::fs::write(
+        work_dir.join(TIMING_FILE),
+        serde_json::to_string_pretty(&timing)?,
+    )?;
     let info = serde_json::json!({
         "name": set.name,
         "about": set.about,
@@ -145,7 +178,7 @@ fn generate(set: &SetSpec, quick: bool, seed: u64) -> Result<()> {
         "generated_by": format!("raypath-sim {}", env!("CARGO_PKG_VERSION")),
         "files": entries,
         "bytes": total_bytes,
-        "stats": generated.stats,
+        "stats": stats,
     });
     std::fs::write(
         work_dir.join("set.json"),
@@ -181,7 +214,7 @@ fn list_files(dir: &Path) -> Result<Vec<PathBuf>> {
             if path.is_dir() {
                 stack.push(path);
             } else if let Ok(relative) = path.strip_prefix(dir) {
-                if relative != Path::new("SHA256SUMS") && relative != Path::new("set.json") {
+                if !BOOKKEEPING.iter().any(|b| relative == Path::new(b)) {
                     out.push(relative.to_path_buf());
                 }
             }
@@ -206,4 +239,43 @@ fn sha256_file(path: &Path) -> Result<(String, u64)> {
     }
     let digest = hasher.finalize();
     Ok((digest.iter().map(|b| format!("{b:02x}")).collect(), total))
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)] // test code: a panic is the failure report
+mod tests {
+    use super::*;
+
+    /// Same seed, same bytes: a set generated twice is identical file for file, `set.json`
+    /// and `SHA256SUMS` included.
+    #[test]
+    fn same_seed_same_bytes() {
+        let set = raypath_sim::datasets::find("polygons").unwrap();
+        let dirs = [tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap()];
+        for dir in &dirs {
+            generate_into(dir.path(), set, true, 7).unwrap();
+        }
+        let [a, b] = [&dirs[0], &dirs[1]].map(|d| d.path().join("polygons"));
+        let mut files = list_files(&a).unwrap();
+        files.extend(["set.json", "SHA256SUMS"].map(PathBuf::from));
+        assert!(files.len() > 2);
+        for file in files {
+            let (x, y) = (
+                std::fs::read(a.join(&file)).unwrap(),
+                std::fs::read(b.join(&file)).unwrap(),
+            );
+            assert!(x == y, "{} differs between two runs", file.display());
+        }
+    }
+
+    #[test]
+    fn timings_leave_the_set_description() {
+        let mut stats = serde_json::json!({"scans": 3, "elapsed_s": 1.5, "rays_per_s": 2e6});
+        let timing = take_timing(&mut stats, 2.0);
+        assert_eq!(stats, serde_json::json!({"scans": 3}));
+        assert_eq!(
+            timing,
+            serde_json::json!({"elapsed_s": 1.5, "rays_per_s": 2e6, "total_s": 2.0})
+        );
+    }
 }

@@ -291,7 +291,11 @@ fn real_ouster_frame() {
         })
         .map(|p| p["points"].as_u64().unwrap())
         .sum();
-    assert!(ground > 10_000, "{ground} ground points in {} planes", planes.len());
+    assert!(
+        ground > 10_000,
+        "{ground} ground points in {} planes",
+        planes.len()
+    );
     let written = std::fs::read_to_string(&labels).unwrap();
     assert_eq!(written.lines().count(), 128 * 1024);
     let out = raypath(&["planes", pcap.to_str().unwrap(), "--frame-index", "3"]);

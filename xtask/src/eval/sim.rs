@@ -57,11 +57,21 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         let dir = generate::ensure(spec.name, ctx.quick)?;
         let text = std::fs::read_to_string(dir.join("set.json"))
             .with_context(|| format!("reading {}/set.json", dir.display()))?;
+        let mut info: Value = serde_json::from_str(&text)?;
+        // Timings live beside set.json (same seed, same bytes); shown with the statistics.
+        if let Ok(text) = std::fs::read_to_string(dir.join(generate::TIMING_FILE))
+            && let (Ok(Value::Object(timing)), Some(stats)) = (
+                serde_json::from_str::<Value>(&text),
+                info.get_mut("stats").and_then(Value::as_object_mut),
+            )
+        {
+            stats.extend(timing);
+        }
         sets.push(SetOnDisk {
             name: spec.name,
             about: spec.about,
             dir,
-            info: serde_json::from_str(&text)?,
+            info,
         });
     }
 
