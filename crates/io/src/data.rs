@@ -29,7 +29,9 @@ pub fn find(relative: impl AsRef<Path>) -> Option<PathBuf> {
 
 /// For tests and examples that need real data: the path of `relative` under the data
 /// directory, or `None` after printing a "skipping" message that names the missing path, so a
-/// test can `return` early when the data set is not installed.
+/// test can `return` early when the data set is not installed. When the environment sets
+/// `RAYPATH_REQUIRE_DATA=1` (CI does whenever it has the data), a missing path panics
+/// instead, so no real-data test can pass by skipping.
 ///
 /// ```
 /// let Some(log) = raypath_io::data::require("carmen/corrected/intel-corrected.log.gz") else {
@@ -39,6 +41,12 @@ pub fn find(relative: impl AsRef<Path>) -> Option<PathBuf> {
 /// ```
 pub fn require(relative: impl AsRef<Path>) -> Option<PathBuf> {
     let found = find(relative.as_ref());
+    if found.is_none() && std::env::var("RAYPATH_REQUIRE_DATA").is_ok_and(|v| v == "1") {
+        panic!(
+            "RAYPATH_REQUIRE_DATA=1 but {} is missing",
+            data_dir().join(relative).display()
+        );
+    }
     if found.is_none() {
         eprintln!(
             "skipping: {} not found (set RAYPATH_DATA to the data directory)",
