@@ -340,7 +340,10 @@ pub fn run(ctx: &EvalContext, vocabulary: Option<&Arc<BinaryVocabulary>>) -> Res
         stats.to_markdown()
     )?;
     let summary = vec![format!(
-        "Real 3-D (40 real KITTI frames, kidnapped): best match in the same sequence — {}.",
+        "Real 3-D ({} real frames of {}, kidnapped; counted over the {n} with another frame of \
+         their own source): best match in the same source — {}.",
+        frames.len(),
+        found.join(", "),
         fractions.join(", ")
     )];
     Ok(Section {
