@@ -60,6 +60,28 @@ impl EvalContext {
         self.data_dir.join(relative)
     }
 
+    /// The semi-synthetic KITTI drive of `kitti-poles/<sequence>` (its real trajectory, times
+    /// and pole map) cut to its first `scans` scans; `None` when the directory is absent.
+    pub fn semi_kitti_config(
+        &self,
+        sequence: &str,
+        scans: usize,
+    ) -> Result<Option<raypath_sim::semi_kitti::SemiKittiConfig>> {
+        let dir = self.data(&format!("kitti-poles/{sequence}"));
+        if !dir.join("poses.txt").is_file() || !dir.join("poles.csv").is_file() {
+            return Ok(None);
+        }
+        let mut config = raypath_sim::semi_kitti::SemiKittiConfig::from_files(
+            &dir.join("poses.txt"),
+            &dir.join("times.txt"),
+            &dir.join("poles.csv"),
+        )
+        .with_context(|| format!("reading {}", dir.display()))?;
+        config.sequence = sequence.to_owned();
+        config.max_scans = Some(scans);
+        Ok(Some(config))
+    }
+
     /// Where an evaluation may write pictures that belong to its report
     /// (`docs/results/<name>/`), created on demand.
     pub fn figure_dir(&self, name: &str) -> Result<PathBuf> {

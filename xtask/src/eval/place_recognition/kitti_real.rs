@@ -16,7 +16,7 @@ use raypath_place_recognition::{
     AngularSpan, BinaryVocabulary, EquirectConfig, Exclusion, GroundTruth, equirectangular,
 };
 use raypath_sim::datasets::DEFAULT_SEED;
-use raypath_sim::semi_kitti::{SemiKittiConfig, SemiKittiDrive};
+use raypath_sim::semi_kitti::SemiKittiDrive;
 use serde_json::json;
 
 use super::camera::{ImageStats, image_stats};
@@ -123,17 +123,9 @@ fn load(ctx: &EvalContext) -> Result<Loaded> {
 /// Intensity images of simulated scans at the poses of the real frames (frames 0–9 of
 /// `kitti-poles/NN`).
 fn simulated_images(ctx: &EvalContext, seq: &str) -> Result<Option<Vec<GrayImage>>> {
-    let dir = ctx.data(&format!("kitti-poles/{seq}"));
-    if !dir.join("poses.txt").exists() {
+    let Some(mut config) = ctx.semi_kitti_config(seq, FRAMES)? else {
         return Ok(None);
-    }
-    let mut config = SemiKittiConfig::from_files(
-        &dir.join("poses.txt"),
-        &dir.join("times.txt"),
-        &dir.join("poles.csv"),
-    )?;
-    config.sequence = seq.to_owned();
-    config.max_scans = Some(FRAMES);
+    };
     config.labels = false;
     let drive = SemiKittiDrive::new(&config, DEFAULT_SEED)?;
     let images = (0..drive.len())

@@ -24,7 +24,7 @@ use raypath_poles::{
     SweepTiming, greedy_matches, read_pole_csv,
 };
 use raypath_sim::datasets::DEFAULT_SEED;
-use raypath_sim::semi_kitti::{SemiKittiConfig, SemiKittiDrive};
+use raypath_sim::semi_kitti::SemiKittiDrive;
 use raypath_sim::urban::kinds::PoleKind;
 use serde_json::{Value, json};
 
@@ -117,18 +117,9 @@ fn simulated(
     sequence: &str,
     moving: bool,
 ) -> Result<Option<(LabelledLocalMap, Vec<ReferencePole>)>> {
-    let dir = ctx.data(&format!("kitti-poles/{sequence}"));
-    if !dir.join("poses.txt").exists() {
+    let Some(mut config) = ctx.semi_kitti_config(sequence, FRAMES)? else {
         return Ok(None);
-    }
-    let mut config = SemiKittiConfig::from_files(
-        &dir.join("poses.txt"),
-        &dir.join("times.txt"),
-        &dir.join("poles.csv"),
-    )
-    .with_context(|| format!("reading {}", dir.display()))?;
-    config.sequence = sequence.to_owned();
-    config.max_scans = Some(FRAMES);
+    };
     config.sweep_motion = moving;
     let sim = SemiKittiDrive::new(&config, DEFAULT_SEED)
         .with_context(|| format!("building the world of semi-kitti {sequence}"))?;

@@ -4,10 +4,10 @@
 
 use std::fmt::Write;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use raypath_geometry::PointCloud;
 use raypath_io::kitti::KittiSequence;
-use raypath_sim::semi_kitti::{SemiKittiConfig, SemiKittiDrive};
+use raypath_sim::semi_kitti::SemiKittiDrive;
 use serde_json::{Value, json};
 
 use crate::eval::EvalContext;
@@ -136,19 +136,13 @@ fn sequence_stats(
     frames: usize,
 ) -> Result<Option<(Stats, Stats, usize)>> {
     let real_dir = ctx.data(&format!("kitti/sequences/{seq}"));
-    let map_dir = ctx.data(&format!("kitti-poles/{seq}"));
-    if !real_dir.join("velodyne").is_dir() || !map_dir.join("poles.csv").is_file() {
-        eprintln!("sim: real KITTI {seq} or its pole map is absent, skipping it");
-        return Ok(None);
-    }
-    let mut config = SemiKittiConfig::from_files(
-        &map_dir.join("poses.txt"),
-        &map_dir.join("times.txt"),
-        &map_dir.join("poles.csv"),
-    )
-    .with_context(|| format!("reading {}", map_dir.display()))?;
-    config.sequence = seq.to_owned();
-    config.max_scans = Some(frames);
+    let config = match ctx.semi_kitti_config(seq, frames)? {
+        Some(config) if real_dir.join("velodyne").is_dir() => config,
+        _ => {
+            eprintln!("sim: real KITTI {seq} or its pole map is absent, skipping it");
+            return Ok(None);
+        }
+    };
     let drive = SemiKittiDrive::new(&config, SEED)?;
     let mut elevations = drive.lidar().elevations_rad.clone();
     elevations.sort_by(f64::total_cmp);
