@@ -11,7 +11,7 @@ use raypath_io::data::require;
 use raypath_io::pcd::{DataEncoding, write_pcd};
 
 mod common;
-use common::raypath;
+use common::{json_of, raypath};
 
 /// A 40 × 30 organized scan of the wall x = 3 m (label 10) and the floor z = −1 m
 /// (label 11), labels in `intensity`.
@@ -115,7 +115,7 @@ fn planes_json_and_labels_round_trip_through_the_evaluator() {
     let scan = dir.path().join("scene.pcd");
     write_scene(&scan);
     let labels = dir.path().join("labels.txt");
-    let out = raypath(&[
+    let doc = json_of(&raypath(&[
         "planes",
         scan.to_str().unwrap(),
         "--preset",
@@ -125,13 +125,7 @@ fn planes_json_and_labels_round_trip_through_the_evaluator() {
         "--out",
         labels.to_str().unwrap(),
         "--json",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    ]));
     let planes = doc["planes"].as_array().unwrap();
     assert!(planes.len() >= 2);
     for key in ["label", "normal", "distance", "points", "rmse"] {
@@ -149,20 +143,14 @@ fn planes_json_and_labels_round_trip_through_the_evaluator() {
     );
     let text = std::fs::read_to_string(&labels).unwrap();
     assert_eq!(text.lines().count(), 1200);
-    let out = raypath(&[
+    let doc = json_of(&raypath(&[
         "segcomp-eval",
         "--truth",
         scan.to_str().unwrap(),
         "--labels",
         labels.to_str().unwrap(),
         "--json",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    ]));
     assert_eq!(doc["gt_planes"], 2);
     assert_eq!(doc["correct"], 2, "{doc}");
     assert!(doc["k"].as_f64().unwrap() == 1.0);
@@ -178,19 +166,13 @@ fn real_synpeb_sample() {
     };
     let dir = tempfile::tempdir().unwrap();
     let labels = dir.path().join("labels.txt");
-    let out = raypath(&[
+    let doc = json_of(&raypath(&[
         "planes",
         sample.to_str().unwrap(),
         "--out",
         labels.to_str().unwrap(),
         "--json",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    ]));
     assert_eq!(
         (doc["width"].as_u64(), doc["height"].as_u64()),
         (Some(100), Some(100))
@@ -261,7 +243,7 @@ fn real_ouster_frame() {
     };
     let dir = tempfile::tempdir().unwrap();
     let labels = dir.path().join("labels.txt");
-    let out = raypath(&[
+    let doc = json_of(&raypath(&[
         "planes",
         pcap.to_str().unwrap(),
         "--frame-index",
@@ -271,13 +253,7 @@ fn real_ouster_frame() {
         "--out",
         labels.to_str().unwrap(),
         "--json",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    ]));
     assert_eq!(
         (doc["width"].as_u64(), doc["height"].as_u64()),
         (Some(1024), Some(128))
