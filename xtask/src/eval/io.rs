@@ -57,6 +57,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     let mut results = Vec::new();
     let mut failures = Vec::new();
     let mut unknown = Vec::new();
+    let mut unsupported = Vec::new();
     for path in &data {
         let relative = path
             .strip_prefix(&ctx.data_dir)
@@ -65,6 +66,15 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             .to_string();
         bar.set_message(relative.clone());
         let format = match Format::detect(path) {
+            // Recognised, and refused by design with the command that converts it.
+            Ok(Format::OusterOsf) => {
+                let refusal = raypath_io::summarize_as(path, Format::OusterOsf)
+                    .err()
+                    .map_or_else(String::new, |e| e.to_string());
+                unsupported.push((relative, refusal));
+                bar.inc(1);
+                continue;
+            }
             Ok(format) => format,
             Err(error) => {
                 unknown.push((relative, error.to_string()));
@@ -161,10 +171,15 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     markdown.push_str("\n## Files\n\n");
     markdown.push_str(&table.to_markdown());
 
-    if !failures.is_empty() || !unknown.is_empty() {
+    if !failures.is_empty() || !unknown.is_empty() || !unsupported.is_empty() {
         markdown.push_str("\n## Not read\n\n");
         for (path, error) in failures.iter().chain(&unknown) {
             markdown.push_str(&format!("- `{path}`: {error}\n"));
+        }
+        for (path, refusal) in &unsupported {
+            markdown.push_str(&format!(
+                "- `{path}`: recognised, reading not supported (the reader refuses it: {refusal})\n"
+            ));
         }
     }
     markdown.push_str(&format!(
@@ -190,6 +205,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         })).collect::<Vec<_>>(),
         "failures": failures.iter().map(|(p, e)| serde_json::json!({"path": p, "error": e})).collect::<Vec<_>>(),
         "unknown": unknown.iter().map(|(p, e)| serde_json::json!({"path": p, "error": e})).collect::<Vec<_>>(),
+        "unsupported": unsupported.iter().map(|(p, e)| serde_json::json!({"path": p, "refusal": e})).collect::<Vec<_>>(),
     });
     if !failures.is_empty() {
         anyhow::bail!(
