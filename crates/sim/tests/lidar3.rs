@@ -50,6 +50,13 @@ fn noiseless(mut lidar: Lidar3) -> Lidar3 {
 }
 
 /// Analytic range of a beam from `origin` (height h above the floor) to the floor or wall.
+/// The unit direction of beam (`row`, `col`) from its elevation and azimuth, computed here
+/// rather than taken from the simulator so the tests check it.
+fn beam(lidar: &Lidar3, row: usize, col: usize) -> Vector3<f64> {
+    let (el, az) = (lidar.elevations_rad[row], lidar.azimuths_rad[col]);
+    Vector3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin())
+}
+
 fn analytic(origin: &Point3<f64>, dir: &Vector3<f64>) -> Option<(f64, u32)> {
     let floor = (dir.z < 0.0).then(|| -origin.z / dir.z);
     let wall = (dir.x > 0.0).then(|| (20.0 - origin.x) / dir.x);
@@ -74,8 +81,7 @@ fn hdl64e_ranges_on_floor_and_wall_match_the_analytic_answer() {
     for row in 0..64 {
         for col in 0..360 {
             let i = row * 360 + col;
-            let (el, az) = (lidar.elevations_rad[row], lidar.azimuths_rad[col]);
-            let dir = Vector3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+            let dir = beam(&lidar, row, col);
             let p = scan.cloud.points[i];
             match analytic(&origin, &dir).filter(|(r, _)| *r <= lidar.max_range_m && *r >= 0.9) {
                 Some((r, label)) => {
@@ -186,8 +192,8 @@ fn angular_noise_spreads_grazing_ranges_and_keeps_nominal_directions() {
     let mut expected_sq = 0.0;
     for (i, p) in scan.cloud.points.iter().enumerate() {
         let (row, col) = (i / 100, i % 100);
-        let (el, az) = (lidar.elevations_rad[row], lidar.azimuths_rad[col]);
-        let dir = Vector3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+        let el = lidar.elevations_rad[row];
+        let dir = beam(&lidar, row, col);
         let v = p.coords.cast::<f64>();
         assert!(
             (v.normalize() - dir).norm() < 1e-6,
@@ -291,8 +297,7 @@ fn moving_sweeps_start_beams_where_the_sensor_was_and_report_in_the_reference_fr
     for row in 0..64 {
         for col in 0..360 {
             let i = row * 360 + col;
-            let (el, az) = (lidar.elevations_rad[row], lidar.azimuths_rad[col]);
-            let dir = Vector3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+            let dir = beam(&lidar, row, col);
             let tau = (col as f64 + 0.5) / 360.0 - 0.5;
             let start = Point3::new(2.0 * tau, 0.0, 1.73);
             let Some((r, _)) = analytic(&start, &dir).filter(|(r, _)| (0.9..=120.0).contains(r))
