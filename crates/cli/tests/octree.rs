@@ -241,6 +241,16 @@ fn bad_input_exits_2_with_file_and_place() {
 
     let bad_resolution = raypath(&["octree", graph.to_str().unwrap(), "--resolution", "-1"]);
     assert_eq!(bad_resolution.status.code(), Some(2));
+    // At 1 nm the lattice reaches ±33 µm: every point of the room would fall off it.
+    let tiny = raypath(&["octree", graph.to_str().unwrap(), "--resolution", "1e-9"]);
+    assert_eq!(tiny.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&tiny.stderr);
+    assert!(
+        err.contains("room.graph")
+            && err.contains("7200 of 7200 points")
+            && err.contains("lattice"),
+        "{err}"
+    );
 
     let xyz = dir.path().join("bad.xyz");
     std::fs::write(&xyz, "1 2 3\n4 five 6\n").unwrap();

@@ -9,6 +9,12 @@
 /// The key of coordinate 0 (OctoMap's `tree_max_val`).
 pub const KEY_OFFSET: i64 = 32768;
 
+/// How far the lattice reaches from the origin along each axis at resolution `r`:
+/// 32 768 · r metres (3.3 km at 0.1 m). Points beyond it have no key.
+pub fn lattice_half_extent_m(resolution_m: f64) -> f64 {
+    KEY_OFFSET as f64 * resolution_m
+}
+
 /// A base-cube key on the global lattice (x, y, z).
 pub type Key = [u16; 3];
 

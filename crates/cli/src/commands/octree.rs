@@ -206,6 +206,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let mut grid = RtreeGrid::new(config).map_err(|e| Failure::input(e, args.json))?;
     let mut recording = Recording::open(&args.record, args.json)?;
     let (scans, stamps) = load(args)?;
+    check_lattice(args, &scans)?;
     let points: usize = scans.iter().map(|(_, c)| c.num_valid()).sum();
     let started = Instant::now();
     for (pose, cloud) in &scans {
@@ -282,6 +283,41 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         super::record::finish(recording, None)?;
     }
     Ok(())
+}
+
+/// Refuses scans that reach beyond the grid's 16-bit lattice (±32 768 base cubes per axis
+/// around the origin, as OctoMap's): such points would be dropped without a trace.
+fn check_lattice(args: &Args, scans: &Scans) -> Result<(), Failure> {
+    let reach = raypath_rtree_grid::key::lattice_half_extent_m(args.resolution);
+    let inside = |p: &[f64; 3]| p.iter().all(|v| v.abs() < reach);
+    let mut outside = 0usize;
+    let mut total = 0usize;
+    let mut first: Option<usize> = None;
+    for (i, (pose, cloud)) in scans.iter().enumerate() {
+        let mut beyond = !inside(&pose.translation().into());
+        for j in (0..cloud.len()).filter(|&j| cloud.is_valid(j)) {
+            let p = pose.transform_point(&cloud.point_f64(j));
+            total += 1;
+            if !inside(&[p.x, p.y, p.z]) {
+                outside += 1;
+                beyond = true;
+            }
+        }
+        if beyond && first.is_none() {
+            first = Some(i);
+        }
+    }
+    let Some(scan) = first else { return Ok(()) };
+    Err(Failure::input(
+        format!(
+            "{}: {outside} of {total} points (first in scan {scan}) lie beyond the grid's \
+             lattice, which reaches ±{reach:.3} m from the origin at --resolution {} m \
+             (32768 base cubes per axis); choose a coarser --resolution",
+            args.input.display(),
+            args.resolution
+        ),
+        args.json,
+    ))
 }
 
 /// `--record`: the sensor poses (`/tf`, `/trajectory`), the occupied leaves' centres

@@ -41,8 +41,12 @@ pub enum GridError {
 /// What one [`RtreeGrid::insert_scan`] did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ScanUpdate {
-    /// Beams used (finite end points on the lattice).
+    /// Beams used (finite end points).
     pub beams: usize,
+    /// Beams whose end point lies outside the 16-bit lattice (beyond
+    /// [`lattice_half_extent_m`](crate::key::lattice_half_extent_m) of the origin on some axis):
+    /// their end cube is not updated and their ray only where it is on the lattice.
+    pub off_lattice: usize,
     /// Distinct base cubes updated as free.
     pub free_keys: usize,
     /// Distinct base cubes updated as occupied.
@@ -218,9 +222,10 @@ impl RtreeGrid {
         let r = self.config.resolution_m;
         let origin = [origin_m.x, origin_m.y, origin_m.z];
         let beam = self.config.model == SensorModel::BeamBased;
-        // §2.F.1: end-point cells always start fusions; each cell a beam traversed does so
-        // with probability 1 / spacing (the thesis samples ⌈len / (s·r)⌉ random cells per beam:
-        // the same expected number, drawn from the de-duplicated traversed cells).
+        // §2.5.2, Fig. 2.6: end-point cells always start fusions; each cell a beam traversed does
+        // so with probability 1 / spacing (the thesis samples random cells along each beam by its
+        // length, with no number; ⌈len / (s·r)⌉ per beam gives the same expected number, drawn
+        // here from the de-duplicated traversed cells).
         let sample_probability = match self.config.selection {
             _ if !beam || !self.config.fusion => 0.0,
             Selection::BeamSamples { spacing_cells } => 1.0 / spacing_cells,
@@ -253,10 +258,10 @@ impl RtreeGrid {
                 }
             }
             update.beams += 1;
-            if hit {
-                if let Some(k) = key_of(end, r) {
-                    occupied_keys.push(pack(k));
-                }
+            match key_of(end, r) {
+                Some(k) if hit => occupied_keys.push(pack(k)),
+                Some(_) => {}
+                None => update.off_lattice += 1,
             }
             if beam {
                 ray::ray_keys_with(origin, end, r, |k| {

@@ -212,6 +212,27 @@ fn rejects_bad_parameters() {
 }
 
 #[test]
+fn counts_end_points_off_the_lattice() {
+    let mut grid = RtreeGrid::new(GridConfig {
+        resolution_m: 0.1,
+        ..GridConfig::default()
+    })
+    .unwrap();
+    let reach = crate::key::lattice_half_extent_m(0.1);
+    assert!((reach - 3276.8).abs() < 1e-9);
+    let origin = Point3::new(0.0, 0.0, 0.0);
+    let points = [
+        Point3::new(5.0, 0.0, 0.0),
+        Point3::new(reach + 1.0, 0.0, 0.0),
+        Point3::new(0.0, -reach - 1.0, 0.0),
+    ];
+    let update = grid.insert_scan(&origin, &points);
+    assert_eq!(update.beams, 3);
+    assert_eq!(update.off_lattice, 2);
+    assert_eq!(update.occupied_keys, 1);
+}
+
+#[test]
 fn compaction_keeps_the_map_and_frees_memory() {
     let scan = scan_points(9, 2000);
     let mut grid = RtreeGrid::new(GridConfig::with(0.25, 8, SensorModel::BeamBased)).unwrap();
