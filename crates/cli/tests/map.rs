@@ -302,6 +302,21 @@ fn bad_inputs_exit_2_naming_file_and_place() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("bad.log") && err.contains('3'), "{err}");
 
+    // A log cut mid-line: the complete scans are mapped with a warning; --strict refuses.
+    let whole = std::fs::read_to_string(synthetic_log(dir.path())).expect("read");
+    let cut = dir.path().join("cut.log");
+    std::fs::write(&cut, &whole[..whole.len() - 30]).expect("write");
+    let out = run(&cut, &["--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("cut.log: line 5") && err.contains("mid-line"), "{err}");
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert_eq!(doc["rays"], (SCANS - 1) * BEAMS, "{doc}");
+    let out = run(&cut, &["--strict"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("cut.log") && err.contains('5'), "{err}");
+
     // A log without laser messages.
     let empty = dir.path().join("empty.log");
     std::fs::write(&empty, "# nothing\n").expect("write");

@@ -168,6 +168,7 @@ pub struct LineReader {
     bytes: Vec<u8>,
     text: String,
     line: u64,
+    terminated: bool,
 }
 
 impl LineReader {
@@ -189,6 +190,7 @@ impl LineReader {
             bytes: Vec::with_capacity(4096),
             text: String::with_capacity(4096),
             line: 0,
+            terminated: true,
         }
     }
 
@@ -203,7 +205,8 @@ impl LineReader {
             return Ok(None);
         }
         self.line += 1;
-        if self.bytes.last() == Some(&b'\n') {
+        self.terminated = self.bytes.last() == Some(&b'\n');
+        if self.terminated {
             self.bytes.pop();
         }
         if self.bytes.last() == Some(&b'\r') {
@@ -221,6 +224,12 @@ impl LineReader {
             }
         }
         Ok(Some(&self.text))
+    }
+
+    /// Whether the line last returned ended with a line break. Only the last line of the
+    /// input can lack one: a file cut off mid-line, or one without a final newline.
+    pub fn line_terminated(&self) -> bool {
+        self.terminated
     }
 
     /// The 1-based number of the line last returned (0 before the first).

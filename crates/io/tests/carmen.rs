@@ -332,3 +332,55 @@ fn front_lasers_skip_odometry_and_rear_lasers() {
     // FLASER and ROBOTLASER1 are front lasers; RLASER, ODOM, PARAM and NEFF are skipped.
     assert_eq!(kinds, ["FLASER", "ROBOTLASER1"]);
 }
+
+/// `LOG` cut in the middle of its last line (the `ROBOTLASER1` message).
+fn cut_log() -> String {
+    let end = LOG.find("ROBOTLASER1").unwrap() + 40;
+    LOG[..end].to_owned()
+}
+
+#[test]
+fn a_log_cut_mid_line_keeps_its_complete_records_with_a_warning() {
+    let mut reader = CarmenReader::new(Cursor::new(cut_log().into_bytes()), "cut.log");
+    let records: Vec<_> = reader.by_ref().collect();
+    assert_eq!(records.len(), 6, "{records:?}");
+    assert!(records.iter().all(Result::is_ok));
+    let warnings = reader.take_warnings();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0].contains("cut.log: line 10") && warnings[0].contains("mid-line"),
+        "{}",
+        warnings[0]
+    );
+    // The same line with its line break is malformed, not cut: an error as before.
+    let records = read(&(cut_log() + "\n"));
+    assert!(matches!(
+        records.last(),
+        Some(Err(Error::Malformed {
+            location: Location::Line(10),
+            ..
+        }))
+    ));
+}
+
+#[test]
+fn strict_reading_refuses_a_log_cut_mid_line() {
+    let config = CarmenConfig {
+        strict: true,
+        ..CarmenConfig::default()
+    };
+    let mut reader =
+        CarmenReader::with_config(Cursor::new(cut_log().into_bytes()), "cut.log", config).unwrap();
+    let records: Vec<_> = reader.by_ref().collect();
+    assert_eq!(records.len(), 7);
+    assert!(records[..6].iter().all(Result::is_ok));
+    assert!(records[6].is_err());
+    assert!(reader.take_warnings().is_empty());
+}
+
+#[test]
+fn a_complete_last_line_without_a_line_break_is_read() {
+    let records = read(LOG.trim_end());
+    assert_eq!(records.len(), 7);
+    assert!(records.iter().all(Result::is_ok));
+}

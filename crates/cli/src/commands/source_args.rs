@@ -65,6 +65,10 @@ pub struct SourceArgs {
     /// root of the tf tree).
     #[arg(long, value_name = "FRAME")]
     pub frame: Option<String>,
+    /// CARMEN logs: refuse a log that ends mid-line (by default its last, incomplete line is
+    /// skipped with a warning naming the line, and the complete records are read).
+    #[arg(long)]
+    pub strict: bool,
 }
 
 /// A bag opened as planar scans or as 3-D sweeps (see [`SourceArgs::open_bag`]).
@@ -91,7 +95,10 @@ impl SourceArgs {
     pub fn planar_options(&self) -> PlanarOptions {
         PlanarOptions {
             laser: self.laser.into(),
-            carmen: CarmenConfig::default(),
+            carmen: CarmenConfig {
+                strict: self.strict,
+                ..CarmenConfig::default()
+            },
             topics: self.topics(),
         }
     }

@@ -130,6 +130,12 @@ pub struct CarmenConfig {
     pub lookahead_scans: usize,
     /// Maximum range in metres when nothing else says (the value Schaefer's reader assumes).
     pub default_max_range_m: f64,
+    /// Refuse a log that ends mid-line. By default (`false`) an unreadable last line
+    /// without a line break — a log cut off while it was written or copied — is skipped:
+    /// the complete records before it are read and a warning names the file and the line
+    /// ([`crate::carmen::CarmenReader::take_warnings`]). A malformed line anywhere else is
+    /// an error either way.
+    pub strict: bool,
 }
 
 impl Default for CarmenConfig {
@@ -143,6 +149,7 @@ impl Default for CarmenConfig {
             no_return: NoReturnRange::Infer,
             lookahead_scans: 1000,
             default_max_range_m: 50.0,
+            strict: false,
         }
     }
 }

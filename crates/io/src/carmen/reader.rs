@@ -38,9 +38,13 @@ pub struct CarmenReader {
     config: CarmenConfig,
     params: Params,
     estimates: [Option<NoReturnEstimate>; 3],
-    pending: VecDeque<(u64, Result<Parsed>)>,
+    pending: VecDeque<Pending>,
     done: bool,
+    warnings: Vec<String>,
 }
+
+/// A line read ahead: its number, what it parsed to, and whether it ended with a line break.
+type Pending = (u64, Result<Parsed>, bool);
 
 /// The look-ahead also stops after this many kept lines per laser message it may read.
 const LOOKAHEAD_LINES_PER_SCAN: usize = 100;
@@ -148,7 +152,7 @@ impl CarmenReader {
                 Err(e) => {
                     // A line that is not UTF-8 is skipped; a read error ends the stream.
                     let fatal = matches!(e, Error::Io { .. });
-                    pending.push_back((line, Err(e)));
+                    pending.push_back((line, Err(e), true));
                     if fatal {
                         done = true;
                         break;
@@ -156,14 +160,15 @@ impl CarmenReader {
                     continue;
                 }
             };
+            let terminated = lines.line_terminated();
             match parsed {
                 Ok(Parsed::Skip) => {}
                 Ok(parsed) => {
                     scans += usize::from(matches!(parsed, Parsed::Laser(_)));
                     prepass.feed(&parsed);
-                    pending.push_back((line, Ok(parsed)));
+                    pending.push_back((line, Ok(parsed), terminated));
                 }
-                Err(e) => pending.push_back((line, Err(e))),
+                Err(e) => pending.push_back((line, Err(e), terminated)),
             }
         }
         Self::from_parts(lines, config, prepass, pending, done)
@@ -173,7 +178,7 @@ impl CarmenReader {
         lines: LineReader,
         config: CarmenConfig,
         prepass: Prepass,
-        pending: VecDeque<(u64, Result<Parsed>)>,
+        pending: VecDeque<Pending>,
         done: bool,
     ) -> Self {
         let [front, rear, robot] = &prepass.histograms;
@@ -185,7 +190,14 @@ impl CarmenReader {
             estimates: [front.estimate(), rear.estimate(), robot.estimate()],
             pending,
             done,
+            warnings: Vec::new(),
         }
+    }
+
+    /// Warnings since the last call (a last line cut off mid-line and skipped), each naming
+    /// the file and the line.
+    pub fn take_warnings(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.warnings)
     }
 
     /// The inferred no-return encoding of the messages of `kind` (`None` when the
@@ -306,13 +318,16 @@ impl Iterator for CarmenReader {
 
     fn next(&mut self) -> Option<Self::Item> {
         loop {
-            let (line, parsed) = match self.pending.pop_front() {
+            let (line, parsed, terminated) = match self.pending.pop_front() {
                 Some(item) => item,
                 None if self.done => return None,
                 None => {
                     let line = self.lines.line_number() + 1;
                     match self.lines.next_line() {
-                        Ok(Some(text)) => (line, parse_line(text, &self.name, line)),
+                        Ok(Some(text)) => {
+                            let parsed = parse_line(text, &self.name, line);
+                            (line, parsed, self.lines.line_terminated())
+                        }
                         Ok(None) => {
                             self.done = true;
                             return None;
@@ -327,6 +342,17 @@ impl Iterator for CarmenReader {
             match parsed.and_then(|p| self.finish(line, p)) {
                 Ok(None) => {}
                 Ok(Some(record)) => return Some(Ok(record)),
+                Err(e) if !terminated && !self.config.strict => {
+                    // The file ends mid-line: keep what came before, say what was dropped.
+                    self.warnings.push(format!(
+                        "{}: line {line}: the file ends mid-line; this last line was skipped \
+                         ({e}); the complete records before it were read (strict reading \
+                         refuses the log)",
+                        self.name.display()
+                    ));
+                    self.done = true;
+                    self.pending.clear();
+                }
                 Err(e) => return Some(Err(e)),
             }
         }

@@ -173,7 +173,11 @@ impl Iterator for CarmenScans {
             return Some(Ok(PlanarFrame::from_carmen(m)));
         }
         loop {
-            let record = self.reader.as_mut()?.next();
+            let reader = self.reader.as_mut()?;
+            let record = reader.next();
+            for warning in reader.take_warnings() {
+                eprintln!("warning: {warning}");
+            }
             match record {
                 Some(Ok(Record::Laser(m))) => {
                     if let Some(m) = self.wanted(m) {
