@@ -2,7 +2,7 @@
 //! mapping and held-back rays, fitting a DCT map and a grid map with as many parameters,
 //! and scoring both against a fine ground-truth grid and on the held-back rays.
 //!
-//! The thesis leaves the patch and ray selection open (spec §5.6); here:
+//! The thesis leaves the patch and ray selection open (Sec. 9.5); here:
 //! * **patch**: corners on a 1 m lattice; each candidate's weight is the ray path length
 //!   inside it (rays traced at most [`PATCH_TRACE_M`] metres, on a 1 m grid). The `auto`
 //!   patch is the heaviest (ties: smallest x, then y). The evaluation draws, with a seed,

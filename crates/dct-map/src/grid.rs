@@ -4,7 +4,7 @@
 //! The statistics `H_i`, `M_i`, `R_i` are gathered from the same [`MapRay`]s with the exact
 //! 2-D traversal of `raypath-geometry`, and the map is `raypath-sensor-models`'
 //! [`DecayRateModel2`] (`λ_i = H_i / R_i`, floored at `1e-3 /m`, unobserved cells at the
-//! mean rate — its defaults). `sub` rays are ignored in mapping, as there (spec A1).
+//! mean rate — its defaults). `sub` rays are ignored in mapping, as there.
 
 use nalgebra::{Point2, Unit, Vector2};
 use raypath_geometry::{Grid2, Range, Ray2};
@@ -138,9 +138,9 @@ impl GridRateMap {
 }
 
 impl DctMap {
-    /// The DCT map whose amplitude `g` equals `√λ` at the centres of an `L × M` lattice over
-    /// the extent: an exact forward DCT-II of `√λ` (the CEIDCT interpolates it, spec §5.3).
-    /// `rates` are row-major `ix · M + iy`; negative or non-finite rates are rejected.
+    /// The DCT map whose amplitude `g` equals `√λ` at the centres of an `L × M` lattice over the
+    /// extent: an exact forward DCT-II of `√λ` (the CEIDCT of Sec. 9.4.2 interpolates it). `rates`
+    /// are row-major `ix · M + iy`; negative or non-finite rates are rejected.
     pub fn from_rates_at_centres(
         extent_m: [f64; 2],
         shape: Shape,

@@ -2,8 +2,7 @@
 //!
 //! Continuous decay-rate maps in the cosine domain — **DCT maps** — after Schaefer (2020),
 //! *Lidar mapping and localization*, **ch. 9** ("DCT Maps: Compact Differentiable Lidar Maps
-//! Based on the Cosine Transform"); equations are numbered as in the thesis and in the
-//! raypath spec `schaefer-2020-maps.md` §5.
+//! Based on the Cosine Transform"); equations are numbered as in the thesis.
 //!
 //! ## The idea
 //!
@@ -82,11 +81,11 @@
 //!   [`derivatives`], whose test shows the printed form failing finite differences.
 //! * `C_i = ⅛ Σ_j a_j Σ A_ij + A_ji` is read as `Σ (A_ij + A_ji)`.
 //! * Map frame: `x̃ = π x / X` with `x` measured from the patch's lower-left corner.
-//! * **Eq. (9.10) taken literally is unstable** for nearly axis-parallel rays: a direction
-//!   such as `(cos π/2, −1) = (6e-17, −1)` gives `ω ≈ 1e-17 ≠ 0`, and
-//!   `(sin(φ + ωr) − sin φ)/ω` divides rounding noise by it. The `sinc` form
-//!   `r cos(φ + ωr/2) sinc(ωr/2)` (spec §5.4) is used everywhere; the literal form is kept in
-//!   [`reference`](mod@reference) and the test shows the difference.
+//! * **Eq. (9.10) taken literally is unstable** for nearly axis-parallel rays: a direction such as
+//!   `(cos π/2, −1) = (6e-17, −1)` gives `ω ≈ 1e-17 ≠ 0`, and `(sin(φ + ωr) − sin φ)/ω` divides
+//!   rounding noise by it. The `sinc` form `r cos(φ + ωr/2) sinc(ωr/2)` (the same integral,
+//!   rewritten) is used everywhere; the literal form is kept in [`reference`](mod@reference) and
+//!   the test shows the difference.
 //! * **Ridge.** The thesis maximizes the bare likelihood. With fewer rays than coefficients
 //!   (its own 500-ray timing sets at 40 × 40) the Gram matrix has near-null directions, and
 //!   along them the rounding error of `aᵀ K a` let Newton's method "increase" the likelihood

@@ -137,7 +137,8 @@ impl DctMap {
     }
 
     /// The optical depth `𝒮 = ∫_0^r λ(s + v t) dt` of a segment (Eq. 9.9–9.10), through the
-    /// self-convolution: `Σ_pq b_pq T_pq` with the closed-form moments `T_pq` (spec §5.9).
+    /// self-convolution: `Σ_pq b_pq T_pq` with the closed-form moments `T_pq` (an exact
+    /// rearrangement of Eq. 9.10, not in the thesis).
     pub fn optical_depth(&self, ray: &MapRay) -> f64 {
         let mut t = vec![0.0; self.b.len()];
         add_moments(self.shape, self.extent_m, &ray.segment(), 1.0, &mut t);

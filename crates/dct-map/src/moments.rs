@@ -1,9 +1,8 @@
 //! Closed-form cosine moments of a ray segment: `T_pq = ∫_0^r cos(p x̃(t)) cos(q ỹ(t)) dt`.
 //!
 //! Along `x(t) = s + v t` the phases are linear in `t`; with the product-to-sum identity
-//! `cos(p x̃) cos(q ỹ) = ½ Σ_± cos(p x̃ ± q ỹ)` every term integrates in closed form
-//! (Eq. (9.10) with the `sinc` form of spec §5.4, which covers the axis-parallel case
-//! `ω = 0` without a branch):
+//! `cos(p x̃) cos(q ỹ) = ½ Σ_± cos(p x̃ ± q ỹ)` every term integrates in closed form (Eq. (9.10),
+//! rewritten with `sinc`, which covers the axis-parallel case `ω = 0` without a branch):
 //!
 //! ```text
 //! ∫_0^r cos(φ + ω t) dt = r · cos(φ + ω r / 2) · sinc(ω r / 2),   sinc(u) = sin(u) / u.

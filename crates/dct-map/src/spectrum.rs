@@ -54,7 +54,8 @@ impl Shape {
 }
 
 /// The cosine self-convolution `b_pq` of the coefficients `a` (row-major `l · M + m`):
-/// `λ(x, y) = Σ_pq b_pq cos(p x̃) cos(q ỹ)` exactly (spec §5.9). `O(4 I²)`.
+/// `λ(x, y) = Σ_pq b_pq cos(p x̃) cos(q ỹ)` exactly (an algebraic rearrangement of Eq. (9.7),
+/// not in the thesis). `O(4 I²)`.
 pub fn self_convolution(shape: Shape, a: &[f64]) -> Vec<f64> {
     let (lm, mm, qn) = (shape.l, shape.m, shape.q());
     let mut b = vec![0.0; shape.spectrum_len()];

@@ -118,7 +118,7 @@ fn lzw_matches_compress_program_when_installed() {
 #[test]
 fn sc2cart_known_answers() {
     let g = PerceptronGeometry::default();
-    // Computed by hand from the formulas of the spec (§5.2), in the file's unit.
+    // Computed by hand from the formulas of `PerceptronGeometry`'s docs, in the file's unit.
     let cases = [
         (
             (0, 0, 2000.0),

@@ -3,7 +3,7 @@
 //!
 //! The measurement model is 8 beacon ranges with Gaussian noise (8 square roots per
 //! particle). Every configuration runs on one thread and on all cores (a rayon pool each).
-//! Issue 8 needs 5000 particles at ≥ 50 Hz with pole landmarks: the filter's share of the
+//! Pole-landmark localization aims at 5000 particles at ≥ 50 Hz: the filter's share of the
 //! 20 ms budget is what `step` reports here.
 //!
 //! Run: `cargo bench -p raypath-localizer --bench filter`.

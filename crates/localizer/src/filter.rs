@@ -7,10 +7,10 @@
 //! 2. **update** — every log-weight grows by the measurement log-likelihood,
 //!    lᵢ ← lᵢ + ln p(z | xᵢ) (in parallel), then log-sum-exp normalization
 //!    ([`crate::weights`]);
-//! 3. **resample** when the effective sample size falls below a fraction of the particle
-//!    count, ESS / N < [`FilterConfig::resample_ess_ratio`] (default 0.5 as in the polex
-//!    implementation of Schaefer 2020, ch. 12; erratum 15: the thesis's `ESS < 0.5` is read as
-//!    ESS / N), by low-variance resampling ([`crate::resample`]) or, with
+//! 3. **resample** when the effective sample size falls below a fraction of the particle count,
+//!    ESS / N < [`FilterConfig::resample_ess_ratio`] (default 0.5 as in the polex implementation of
+//!    Schaefer 2020, ch. 12; the thesis's `ESS < 0.5` never holds for normalized weights, ESS ≥ 1,
+//!    and is read as ESS / N), by low-variance resampling ([`crate::resample`]) or, with
 //!    [`FilterConfig::kld`], by KLD-sampling ([`crate::kld`]), which also adapts N.
 //!
 //! ## Determinism

@@ -1,14 +1,13 @@
 //! Initial particle distributions.
 //!
-//! * [`GaussianInit`]: a Gaussian around a pose. Defaults from Schaefer (2020), ch. 7 (Sec.
-//!   7.6.1, 6-DOF MCL): σ = 1 m in the horizontal plane, 0.2 m vertically, 0.1 rad about
-//!   every rotation axis. The thesis calls these values "variance"; we read them as standard
-//!   deviations (erratum A5 of the maps spec: the units m and rad are those of a standard
-//!   deviation) and expose them as parameters.
-//! * [`UniformDisc`]: uniform in a disc around a pose with a heading interval, for global or
-//!   coarse initialization (Schaefer 2020, ch. 12: radius 2.5 m, ±5°). By default uniform in
-//!   **area** (r = R√u); [`RadialSampling::UniformRadius`] reproduces the polex reference
-//!   implementation, uniform in the radius (denser near the centre, erratum 17).
+//! * [`GaussianInit`]: a Gaussian around a pose. Defaults from Schaefer (2020), ch. 7 (Sec. 7.6.1,
+//!   6-DOF MCL): σ = 1 m in the horizontal plane, 0.2 m vertically, 0.1 rad about every rotation
+//!   axis. The thesis calls these values "variance"; we read them as standard deviations (their
+//!   units, m and rad, are those of a standard deviation) and expose them as parameters.
+//! * [`UniformDisc`]: uniform in a disc around a pose with a heading interval, for global or coarse
+//!   initialization (Schaefer 2020, ch. 12: radius 2.5 m, ±5°). By default uniform in **area**
+//!   (r = R√u); [`RadialSampling::UniformRadius`] reproduces the polex reference implementation,
+//!   uniform in the radius (denser near the centre; the thesis says "uniformly in a circle").
 //! * [`UniformBox`]: uniform over an axis-aligned box of positions and a heading interval
 //!   (global localization in a known map, SE(2)).
 //!

@@ -30,15 +30,18 @@
 //! | trajectory errors every 1 m, divergence, relative motion | [`eval`] | Schaefer (2020), ch. 12 |
 //! | lidar scans as measurements (any raypath-sensor-models model; beam step, likelihood exponent), log tracking | [`lidar`] | Schaefer (2020), Eq. 7.15; Thrun et al. §6.4 |
 //!
-//! ## Decisions on the thesis's open points (errata)
+//! ## Decisions on the thesis's open points and errata
 //!
-//! * ESS threshold: resample when ESS / N < 0.5 (features spec erratum 15).
-//! * Motion composition: body-frame increments multiply on the right, x' = x · Δ (erratum 16).
-//! * Initial spreads of ch. 7 ("variance" 1 m, 0.2 m, 0.1 rad) are standard deviations
-//!   (maps spec A5); the disc initializer is uniform in area unless asked to mimic the
-//!   reference implementation (erratum 17).
-//! * The thesis states no motion model, resampling scheme or estimator for ch. 7 (A4): we
-//!   use the models above, systematic resampling and, by default, the best-10 % estimator.
+//! * ESS threshold: resample when ESS / N < 0.5. The thesis (§12.5.1) prints ESS < 0.5, which
+//!   never holds for normalized weights (ESS ≥ 1); its reference implementation divides by N.
+//! * Motion composition: body-frame increments multiply on the right, x' = x · Δ, as the
+//!   reference implementation does; the thesis (§12.4.3) prints Δ · x.
+//! * Initial spreads of ch. 7 ("variance" 1 m, 0.2 m, 0.1 rad) are standard deviations (their
+//!   units are those of a standard deviation); the disc initializer is uniform in area unless
+//!   asked to mimic the reference implementation (uniform in the radius, although the thesis
+//!   says "uniformly in a circle").
+//! * The thesis states no motion model, resampling scheme or estimator for ch. 7: we use the
+//!   models above, systematic resampling and, by default, the best-10 % estimator.
 //! * Divergence threshold: the thesis gives none; default 5 m.
 //!
 //! ## Example: beacons in a plane
@@ -114,7 +117,7 @@
 //!
 //! Per particle that is ≈ 54 ns to predict (random stream, three normal draws, two sin/cos),
 //! ≈ 33 ns to weight (most of it the 8 ranges) and ≈ 14 ns to resample, so 5000 particles
-//! at 50 Hz (issue 8's pole-landmark target) spend about 3 % of the 20 ms budget in the
+//! at 50 Hz (the pole-landmark target) spend about 3 % of the 20 ms budget in the
 //! filter. Prediction and weighting scale with rayon (≈ 1.75× on 2 cores when the second
 //! core is free); normalization and resampling are O(N) and partly sequential.
 //!

@@ -2,7 +2,7 @@
 //!
 //! The filter keeps one log-weight lᵢ = ln wᵢ per particle. A measurement update adds the
 //! log-likelihood, lᵢ ← lᵢ + ln p(z | xᵢ), and then normalizes by log-sum-exp (Thrun et al.
-//! 2005, §4.3; spec schaefer-2020-maps §3.11):
+//! 2005, §4.3):
 //!
 //! ```text
 //!   m = maxᵢ lᵢ,   ln Σᵢ e^{lᵢ} = m + ln Σᵢ e^{lᵢ − m},   lᵢ ← lᵢ − ln Σⱼ e^{lⱼ}

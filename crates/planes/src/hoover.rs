@@ -13,9 +13,9 @@
 //! Ground-truth labels below `min_gt_label` (SynPEB/SegComp: 10) are not planes.
 //! `strict` reproduces the reference evaluator's `>` comparisons.
 //!
-//! Also: the k-value (fraction of GT plane rays in correctly detected regions; the
-//! implementation's denominator, errata 9) and the angle deviation `α` over adjacent,
-//! correctly detected GT pairs.
+//! Also: the k-value (fraction of GT plane rays in correctly detected regions; the reference
+//! implementation divides by the rays of GT planes, Eq. (11.5) by all rays `K`) and the angle
+//! deviation `α` over adjacent, correctly detected GT pairs.
 
 use std::collections::HashMap;
 

@@ -79,7 +79,7 @@ impl Segmentation {
     }
 
     /// Per-ray radial RMSE over all rays of all planes (m), the thesis' RMSE as its
-    /// implementation computes it (errata 8).
+    /// implementation computes it (Eq. (11.6) prints a division by the number of planes).
     pub fn rmse_m(&self) -> f64 {
         let n: usize = self.planes.iter().map(|p| p.fit.n).sum();
         if n == 0 {

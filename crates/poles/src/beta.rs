@@ -1,5 +1,5 @@
-//! The Beta-posterior occupancy of a voxel from its hit/miss counts (spec §3.1, after Luft et
-//! al.; Schaefer 2020, ch. 8 and 12).
+//! The Beta-posterior occupancy of a voxel from its hit/miss counts (after Luft et al.;
+//! Schaefer 2020, ch. 8 and §12.4.1).
 //!
 //! A voxel with `h` hits and `m` misses has the reflection-rate posterior
 //! `Beta(h + α, m + β)`; its occupancy is the posterior mass above the threshold `μ_o`,
@@ -23,13 +23,14 @@ pub struct ReflectionPrior {
 }
 
 impl ReflectionPrior {
-    /// Smallest concentration `α + β` accepted from the moments (errata 23 of the spec: a
-    /// (nearly) binary maximum-likelihood map makes the moment estimate degenerate).
+    /// Smallest concentration `α + β` accepted from the moments (a guard the thesis does not
+    /// need: a (nearly) binary maximum-likelihood map makes the moment estimate degenerate,
+    /// with `α, β → 0` or negative).
     pub const MIN_CONCENTRATION: f64 = 1e-3;
 
     /// Fits the prior to the mean `γ` and variance `δ` of the maximum-likelihood reflection
-    /// rates: `α = γc`, `β = (1 − γ)c` with `c = γ(1 − γ)/δ − 1` (spec §3.1, the method of
-    /// moments). Degenerate moments (no data, `δ = 0`, `c` below
+    /// rates: `α = γc`, `β = (1 − γ)c` with `c = γ(1 − γ)/δ − 1` (Schaefer 2020, §12.4.1,
+    /// the method of moments). Degenerate moments (no data, `δ = 0`, `c` below
     /// [`Self::MIN_CONCENTRATION`]) are clamped; the mean is clamped to `[1e-6, 1 − 1e-6]`.
     pub fn from_moments(mean: f64, variance: f64) -> Self {
         let gamma = if mean.is_finite() {

@@ -10,7 +10,8 @@
 //! * **NCLT** (a session directory): scans from `velodyne_sync/` turned to REP-103 axes, the
 //!   ground truth and the integrated odometry (`odometry_mu_100hz.csv`) interpolated at the
 //!   scan times, in REP-103 frames (`NcltPose::world_from_body`; the body frame is the
-//!   velodyne frame in the simulated sessions — spec errata 24: no extrinsic applied).
+//!   velodyne frame in the simulated sessions; like the reference implementation, no
+//!   lidar-to-body extrinsic is applied).
 //! * **rosbag2** (a bag directory or `.mcap` file, `sensor_msgs/msg/PointCloud2`; open with
 //!   [`Drive::open_with`] to choose topics): the reference-pose topic is the ground truth;
 //!   without an odometry topic the odometry track is the reference, as for KITTI. A bag

@@ -1,5 +1,5 @@
-//! Pole extraction from a local map (spec §3.1): occupancy, scores, vertical stacks, the 2-D
-//! score map, seeds at its local maxima, Gaussian mean shift, widths, non-maximum
+//! Pole extraction from a local map (Schaefer 2020, §12.4.1): occupancy, scores, vertical stacks,
+//! the 2-D score map, seeds at its local maxima, Gaussian mean shift, widths, non-maximum
 //! suppression.
 
 use std::time::Instant;
@@ -71,8 +71,8 @@ pub fn extract_poles_from_sweeps(
     Ok((poles, stats))
 }
 
-/// The occupancy `1 − I_{μ_o}(h + α, m + β)` of every voxel (spec §3.1) with the prior fitted
-/// to the counts by the method of moments.
+/// The occupancy `1 − I_{μ_o}(h + α, m + β)` of every voxel (Schaefer 2020, §12.4.1) with the
+/// prior fitted to the counts by the method of moments.
 pub fn occupancy(counts: &HitMissGrid, threshold: f64) -> (Vec<f32>, ReflectionPrior) {
     let prior = ReflectionPrior::estimate(counts.hits(), counts.misses());
     let mut occ = vec![0.0f32; counts.hits().len()];

@@ -1,6 +1,6 @@
-//! The local 3-D grid of hit and miss counts, filled by exact ray traversal (spec §3.1,
-//! `acschaefer/ray_tracing`): every voxel a ray crosses gets a miss; when the endpoint lies
-//! inside the grid, the last voxel's miss becomes a hit. Rays are clipped to the grid.
+//! The local 3-D grid of hit and miss counts, filled by exact ray traversal (Schaefer 2020,
+//! §12.4.1; `acschaefer/ray_tracing`): every voxel a ray crosses gets a miss; when the endpoint
+//! lies inside the grid, the last voxel's miss becomes a hit. Rays are clipped to the grid.
 //!
 //! The walk is [`Tracer`](crate::tracer): `Grid3::traverse`'s clipping and end voxels, then
 //! slab by slab along the major axis with fixed-point side-axis counters and linear-index

@@ -2,8 +2,8 @@
 //!
 //! Pole landmarks from 3-D lidar scans, pole maps and pole-based particle-filter
 //! localization — Schaefer (2020), chapter 12 ("Long-term urban vehicle localization using
-//! pole landmarks", ECMR 2019; reference code `acschaefer/polex`). Spec:
-//! `shared/spec/schaefer-2020-features.md` §3.
+//! pole landmarks", ECMR 2019; reference code `acschaefer/polex`): the approach in §12.4, the
+//! experiments in §12.5.
 //!
 //! ## The idea
 //!
@@ -87,21 +87,29 @@
 //! # Ok::<(), raypath_poles::PoleError>(())
 //! ```
 //!
-//! ## Decisions on the thesis-versus-code conflicts (spec §7)
+//! ## Decisions on the thesis-versus-code conflicts
 //!
-//! * **Score range** (errata 12): scores are remapped `q' = q/2 + 1/2` and `q_min = 0.6`
-//!   applies to `q'`, as the code.
-//! * **μ_o** (13): the thesis's 0.2 in both presets (the code's default 0.05 is not used).
-//! * **σ of pole positions** (14): variances σ² = 1.5 m² (NCLT) and 1.0 m² (KITTI), as the
-//!   code; the gate `d_max` follows from `p_min = 0.01`.
-//! * **n_eff** (15): resample when `n_eff / N < 0.5`.
-//! * **Motion composition** (16): `X_t = X_{t−1} · transform(ξ)` (body-frame increments).
-//! * **Initial particles** (17): uniform in radius, as the code.
-//! * **Mapping window** (20): the NCLT map keeps overlap clusters with ≥ 3 detections (the
-//!   code's global rule); the c-of-w window (c = 2, w = 3) filters online poles.
-//! * **Rounding** (22): `f = round_ties_even(free_length / voxel)` (0.5/0.2 → 2).
-//! * **Beta prior** (23): the concentration of the moment estimate is clamped to ≥ 1e-3.
-//! * **NCLT extrinsic** (24): none (the simulated NCLT body frame is the velodyne frame).
+//! * **Score range**: the thesis scores `q ∈ [−1, 1]` with `q_min = 0.6`; the code remaps
+//!   `q' = q/2 + 1/2` first (so 0.6 means raw 0.2). We follow the code, which gave the results.
+//! * **μ_o**: the thesis's 0.2 in both presets (the code's default 0.05 is not used).
+//! * **σ of pole positions**: the thesis prints "σ = 1 m²" (a variance, by its unit); we use
+//!   the code's variances σ² = 1.5 m² (NCLT) and 1.0 m² (KITTI); the gate `d_max` follows
+//!   from `p_min = 0.01`.
+//! * **n_eff**: the thesis's `(Σ w²)⁻¹ < 0.5` never holds for normalized weights
+//!   (`n_eff ≥ 1`); we resample when `n_eff / N < 0.5`, as the code.
+//! * **Motion composition**: the thesis prints `X_t = transform(ξ) · X_{t−1}`; we use the
+//!   code's `X_t = X_{t−1} · transform(ξ)`, right for body-frame odometry increments.
+//! * **Initial particles**: the thesis says "uniformly in a circle"; we draw uniform in
+//!   radius (denser near the centre), as the code.
+//! * **Mapping window**: the thesis filters the map with the c-of-w window; the NCLT map
+//!   keeps overlap clusters with ≥ 3 detections (the code's global rule); the c-of-w window
+//!   (c = 2, w = 3) filters online poles.
+//! * **Rounding**: `f = round_ties_even(free_length / voxel)` (0.5/0.2 → 2, as NumPy;
+//!   `f64::round` would give 3).
+//! * **Beta prior** (not in the thesis): a (nearly) binary maximum-likelihood map makes the
+//!   moment estimate degenerate; its concentration is clamped to ≥ 1e-3.
+//! * **NCLT extrinsic**: none, as the code (the simulated NCLT body frame is the velodyne
+//!   frame).
 //! * **Widths** (deviation): the width weights are the positive raw scores `max(0, q_a)`,
 //!   not the remapped `q'_a ≥ 0.5`, which weight every width almost equally and pull all
 //!   widths towards the middle of the scored range; the pole score is the stack's mean `Q`.

@@ -1,8 +1,11 @@
-//! Pole-based particle-filter localization on SE(2) (spec §3.3): odometry motion model
-//! `X_t = X_{t−1} · transform(ξ)`, `ξ ~ N(χ, Σ)` (errata 16: body-frame increments),
+//! Pole-based particle-filter localization on SE(2) (Schaefer 2020, §12.4.3): odometry motion
+//! model `X_t = X_{t−1} · transform(ξ)`, `ξ ~ N(χ, Σ)` (the thesis prints
+//! `X_t = transform(ξ) · X_{t−1}`; body-frame increments compose on the right, as in the
+//! reference code),
 //! nearest-neighbour association through a k-d tree with the gate `d_max`, the measurement
-//! model `Π_k (φ_σ(min(d_k, d_max)) + ε)`, low-variance resampling when `n_eff/N < 0.5`
-//! (errata 15), and the estimate as the weighted mean of the best 10 % of particles.
+//! model `Π_k (φ_σ(min(d_k, d_max)) + ε)`, low-variance resampling when `n_eff/N < 0.5` (the
+//! thesis's `(Σ w²)⁻¹ < 0.5` never holds for normalized weights; the code normalizes by `N`),
+//! and the estimate as the weighted mean of the best 10 % of particles.
 
 use kiddo::{KdTree, SquaredEuclidean};
 use nalgebra::Point2;
@@ -22,12 +25,14 @@ use crate::pole::Pole;
 pub struct FilterParams {
     /// Number of particles (NCLT 5000, KITTI 2000).
     pub particles: usize,
-    /// Initial position spread: radius `r ~ U[0, R]`, bearing uniform (errata 17: uniform in
-    /// radius, as the implementation), metres (NCLT 2.5, KITTI 3.0).
+    /// Initial position spread, metres (NCLT 2.5, KITTI 3.0): radius `r ~ U[0, R]`, bearing
+    /// uniform (uniform in radius, as the reference code; the thesis says "uniformly in a
+    /// circle").
     pub init_radius_m: f64,
     /// Initial heading spread `U[−Δφ, Δφ]`, radians (5°).
     pub init_heading_rad: f64,
-    /// Variance σ² of the reference pole positions, m² (errata 14: NCLT 1.5, KITTI 1.0).
+    /// Variance σ² of the reference pole positions, m² (NCLT 1.5, KITTI 1.0, as the reference
+    /// code; the thesis prints "σ = 1 m²").
     pub pole_variance_m2: f64,
     /// Probability ε of a pole not in the map (0.1).
     pub epsilon: f64,
@@ -40,7 +45,7 @@ pub struct FilterParams {
 }
 
 impl FilterParams {
-    /// The NCLT settings (§3.4 and `ncltpoles.py`).
+    /// The NCLT settings (Schaefer 2020, §12.5.1, and `ncltpoles.py`).
     pub fn nclt() -> Self {
         Self {
             particles: 5000,
@@ -54,7 +59,7 @@ impl FilterParams {
         }
     }
 
-    /// The KITTI settings (§3.5 and `kittipoles.py`).
+    /// The KITTI settings (Schaefer 2020, §12.5.2, and `kittipoles.py`).
     pub fn kitti() -> Self {
         Self {
             particles: 2000,

@@ -1,5 +1,6 @@
-//! Pole maps from many local maps (spec §3.2): trajectory segments, merging of poles whose
-//! ground-plane squares overlap (score-weighted), and the c-of-w dynamic-object filter.
+//! Pole maps from many local maps (Schaefer 2020, §12.4.2): trajectory segments, merging of
+//! poles whose ground-plane squares overlap (score-weighted), and the c-of-w dynamic-object
+//! filter.
 
 use std::collections::VecDeque;
 
@@ -16,8 +17,8 @@ pub struct Segment {
     pub center: usize,
 }
 
-/// Segments of a trajectory by travelled distance `d` (spec §3.2, `ncltpoles.py`): segment
-/// `i` holds the scans with `interval·i ≤ d ≤ interval·i + length`, centred at the scan
+/// Segments of a trajectory by travelled distance `d` (Schaefer 2020, §12.4.2; `ncltpoles.py`):
+/// segment `i` holds the scans with `interval·i ≤ d ≤ interval·i + length`, centred at the scan
 /// nearest to `interval·i + length/2`. Empty segments are skipped.
 pub fn segments(positions: &[Point3<f64>], interval_m: f64, length_m: f64) -> Vec<Segment> {
     if positions.is_empty()
@@ -105,7 +106,7 @@ pub fn overlap_clusters(poles: &[Pole]) -> Vec<usize> {
 
 /// Merges poles (e.g. of all local maps) into a map: overlap clusters with at least
 /// `min_members` poles become one pole, the score-weighted mean of centre, heights and
-/// widths, with the mean score (spec §3.2; NCLT `n_mapdetections` = 3, KITTI 1).
+/// widths, with the mean score (Schaefer 2020, §12.4.2; NCLT `n_mapdetections` = 3, KITTI 1).
 pub fn merge_poles(poles: &[Pole], min_members: usize) -> Vec<Pole> {
     let ids = overlap_clusters(poles);
     let mut order: Vec<usize> = (0..poles.len()).collect();
@@ -140,8 +141,8 @@ pub fn merge_poles(poles: &[Pole], min_members: usize) -> Vec<Pole> {
     out
 }
 
-/// The c-of-w dynamic-object filter (spec §3.2/§3.3): a pole of the newest local map is
-/// active when it was seen (overlapping squares) in at least `c` of the last `w` local maps,
+/// The c-of-w dynamic-object filter (Schaefer 2020, §12.4.2–§12.4.3): a pole of the newest local
+/// map is active when it was seen (overlapping squares) in at least `c` of the last `w` local maps,
 /// the newest included (localization: c = 2, w = 3).
 #[derive(Clone, Debug)]
 pub struct SlidingWindowFilter {

@@ -1,4 +1,5 @@
-//! Named parameters of pole extraction with the NCLT and KITTI presets (spec §3.1, §3.2, §6).
+//! Named parameters of pole extraction with the NCLT and KITTI presets (Schaefer 2020,
+//! §12.4.1–§12.4.2 and §12.5, with the reference implementation's values).
 
 use serde::{Deserialize, Serialize};
 
@@ -7,9 +8,9 @@ use crate::error::{Result, require};
 /// Parameters of pole extraction from one local map.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PoleParams {
-    /// Voxel edge length, metres (NCLT 0.2, KITTI 0.1; §3.4, §3.5).
+    /// Voxel edge length, metres (NCLT 0.2, KITTI 0.1; Schaefer 2020, §12.5.1, §12.5.2).
     pub voxel_m: f64,
-    /// Local map extent `(x, y, z)`, metres (NCLT 30 × 30 × 5, KITTI 30 × 30 × 3; §3.2).
+    /// Local map extent `(x, y, z)`, metres (NCLT 30 × 30 × 5, KITTI 30 × 30 × 3; §12.4.2).
     pub extent_m: [f64; 3],
     /// Where the sensor at the segment's centre sits in grid coordinates, metres
     /// (NCLT `(15, 15, 0.5)`, KITTI `(15, 15, 2.0)`; `ncltpoles.py`, `kittipoles.py`).
@@ -18,13 +19,15 @@ pub struct PoleParams {
     /// (NCLT 7, KITTI 10).
     pub max_width_cells: usize,
     /// Free length around a pole, metres: the hull thickness `f = round_ties_even(free/voxel)`
-    /// cells and the non-maximum-suppression distance (NCLT 0.5, KITTI 0.2; errata 22).
+    /// cells and the non-maximum-suppression distance (NCLT 0.5, KITTI 0.2; rounded half to
+    /// even as NumPy, so NCLT's 0.5/0.2 gives `f = 2`).
     pub free_length_m: f64,
-    /// Reflection-rate threshold `μ_o` of the occupancy (thesis 0.2, `mapping.py` 0.05;
-    /// errata 13 — the default follows the thesis).
+    /// Reflection-rate threshold `μ_o` of the occupancy (thesis 0.2 for NCLT; the reference
+    /// code's `mapping.py` uses 0.05; the default follows the thesis).
     pub occupancy_threshold: f64,
-    /// Minimum pole score `q_min` on the `[0, 1]`-remapped score `q' = q/2 + 1/2` (0.6;
-    /// errata 12); must exceed 1/2 (raw score 0).
+    /// Minimum pole score `q_min` on the `[0, 1]`-remapped score `q' = q/2 + 1/2` (0.6, as the
+    /// reference code; the thesis applies it to the raw `q ∈ [−1, 1]`); must exceed 1/2 (raw
+    /// score 0).
     pub min_score: f64,
     /// Minimum pole height `h_min`, metres (1.0).
     pub min_height_m: f64,
@@ -38,7 +41,7 @@ pub struct PoleParams {
 }
 
 impl PoleParams {
-    /// The NCLT preset (§3.4 and `ncltpoles.py`): 0.2 m voxels, 30 × 30 × 5 m, widths
+    /// The NCLT preset (§12.5.1 and `ncltpoles.py`): 0.2 m voxels, 30 × 30 × 5 m, widths
     /// 0.2–1.4 m, free length 0.5 m (f = 2), μ_o = 0.2, q_min = 0.6, h_min = 1 m.
     pub fn nclt() -> Self {
         Self {
@@ -56,7 +59,7 @@ impl PoleParams {
         }
     }
 
-    /// The KITTI preset (§3.5 and `kittipoles.py`): 0.1 m voxels, 30 × 30 × 3 m, widths
+    /// The KITTI preset (§12.5.2 and `kittipoles.py`): 0.1 m voxels, 30 × 30 × 3 m, widths
     /// 0.1–1.0 m, free length 0.2 m (f = 2), otherwise as NCLT.
     pub fn kitti() -> Self {
         Self {
@@ -70,7 +73,7 @@ impl PoleParams {
     }
 
     /// The hull thickness `f` in cells: `round_ties_even(free_length / voxel)`, at least 1
-    /// (errata 22: NumPy rounds 2.5 to 2).
+    /// (ties to even as NumPy, which rounds 2.5 to 2; `f64::round` would give 3).
     pub fn hull_cells(&self) -> usize {
         ((self.free_length_m / self.voxel_m).round_ties_even() as usize).max(1)
     }

@@ -1,5 +1,6 @@
-//! The mapping and localization pipelines on a [`Drive`] (spec §3.2–§3.4): local maps along
-//! trajectory segments, the reference map, and particle-filter runs evaluated every 1 m.
+//! The mapping and localization pipelines on a [`Drive`] (Schaefer 2020, §12.4.2–§12.5): local
+//! maps along trajectory segments, the reference map, and particle-filter runs evaluated every
+//! 1 m.
 
 use std::time::Instant;
 
@@ -22,7 +23,7 @@ use crate::pole::Pole;
 use crate::reference::greedy_matches;
 use crate::sweep::SweepMotion;
 
-/// How local maps are laid along the trajectory (spec §3.2).
+/// How local maps are laid along the trajectory (Schaefer 2020, §12.4.2).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SegmentParams {
     /// Distance between segment starts, metres (NCLT 1.5, KITTI 3).
@@ -198,7 +199,7 @@ pub fn local_maps(
 }
 
 /// The reference map from ground-truth local maps: overlap clusters with at least
-/// `min_map_detections` members, score-weighted (spec §3.2).
+/// `min_map_detections` members, score-weighted (Schaefer 2020, §12.4.2).
 pub fn reference_map(local_maps: &[LocalMap], preset: &Preset) -> Vec<Pole> {
     let all: Vec<Pole> = local_maps
         .iter()

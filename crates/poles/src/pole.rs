@@ -2,9 +2,9 @@
 
 use serde::{Deserialize, Serialize};
 
-/// A pole: centre in the ground plane, vertical extent, footprint width and score (spec §3.1,
-/// the row `[x, y, z_start, z_end, width, score]` of `poles.py`). Metres in the frame of the
-/// map it was extracted in.
+/// A pole: centre in the ground plane, vertical extent, footprint width and score (Schaefer
+/// 2020, §12.4.1; the row `[x, y, z_start, z_end, width, score]` of `poles.py`). Metres in the
+/// frame of the map it was extracted in.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Pole {
     /// Centre x, metres.
@@ -28,7 +28,7 @@ impl Pole {
     }
 
     /// True when the axis-aligned squares (centre, width) of the two poles overlap (closed
-    /// intervals on both axes; spec §3.2, `cluster.py`).
+    /// intervals on both axes; Schaefer 2020, §12.4.2, and `cluster.py`).
     pub fn overlaps(&self, other: &Pole) -> bool {
         let reach = 0.5 * (self.width + other.width);
         (self.x - other.x).abs() <= reach && (self.y - other.y).abs() <= reach

@@ -1,6 +1,6 @@
-//! Pole scores per voxel (spec §3.1): for every footprint width `a` and every voxel `j`, the
-//! best placement of an `a × a` footprint containing `j` of (mean occupancy inside) − (max
-//! occupancy of the free hull of thickness `f` around it), remapped to `[0, 1]`.
+//! Pole scores per voxel (Schaefer 2020, §12.4.1): for every footprint width `a` and every
+//! voxel `j`, the best placement of an `a × a` footprint containing `j` of (mean occupancy
+//! inside) − (max occupancy of the free hull of thickness `f` around it), remapped to `[0, 1]`.
 
 use rayon::prelude::*;
 
@@ -274,7 +274,7 @@ impl SliceWork {
             };
             let update = |b: &mut f32, q: f32, out: &mut u8| {
                 if q > 0.0 {
-                    let remapped = 0.5 * q + 0.5; // errata 12: q' = q/2 + 1/2
+                    let remapped = 0.5 * q + 0.5; // q' = q/2 + 1/2 in [0, 1], as `poles.py`
                     *b = b.max(remapped);
                     *out = (remapped.min(1.0) * 255.0).round() as u8;
                 }

@@ -1,4 +1,5 @@
-//! The particle filter converges from the initial spread on a known map (spec §3.3).
+//! The particle filter converges from the initial spread on a known map (Schaefer 2020,
+//! §12.4.3).
 
 use nalgebra::Point2;
 use proptest::prelude::*;

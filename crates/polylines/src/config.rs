@@ -93,7 +93,8 @@ impl Default for Optimizer {
     }
 }
 
-/// Parameters of polyline extraction (Schaefer 2020, §10; spec §1.6).
+/// Parameters of polyline extraction (Schaefer 2020, Algorithm 1 in §10.4.2 and the
+/// experiments of §10.5).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PolylineConfig {
     /// The extractor.

@@ -85,7 +85,7 @@
 //! Levenberg–Marquardt reaches a lower mean RMSE than Nelder–Mead at all J on simulated
 //! scans and equal within ±0.2 mm on real ones, 2–20 times faster — hence the default.
 //!
-//! ## Decisions on the thesis' open points (spec §7)
+//! ## Decisions on the thesis' open points
 //!
 //! * Eq. (10.2) says `J = J_max`; Algorithm 1 stops at `J ≤ J_max` — a removed two-vertex
 //!   polyline can undershoot by one. We follow Algorithm 1.

@@ -7,8 +7,8 @@
 //! segment after their neighbour); each iteration costs O(log n) plus the intersections of
 //! the beams in the affected sectors.
 //!
-//! Error of removing `v_j` (spec §1.3, the reference implementation's `rmverror`, in units of
-//! `d²/Σ`):
+//! Error of removing `v_j` (`e_j` of Eq. 10.3 in Schaefer 2020, §10.4.2, in the form of the
+//! reference implementation's `rmverror`, in units of `d²/Σ`):
 //!
 //! * interior vertex (or any vertex of a polygon): `R` = returned beams hitting the two
 //!   segments at `v_j` (local polyline only, no occlusion by the rest of the map);

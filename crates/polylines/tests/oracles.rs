@@ -1,4 +1,4 @@
-//! The test oracles of the spec (schaefer-2020-features.md §1.9) and the thesis' claims that
+//! Test oracles for PLE and PLE+ (Schaefer 2020, ch. 10) and the thesis' claims that
 //! hold per scan: noise-free square room, Σ-invariance, f(PLE) = f(PLE+), RMSE → σ_radial
 //! for large J, PLE+ never worse than PLE.
 

@@ -1,4 +1,4 @@
-//! Intensity models for relative reflectivity (Khan 2017 §3.5.1; spec §3.D): raw, range-only
+//! Intensity models for relative reflectivity (Khan 2017 §3.5.1): raw, range-only
 //! and the LUT, and the sample file of `raypath calibrate-intensity`.
 //!
 //! Sample CSV: one `range_m,incidence_rad,intensity` triple per line (metres, radians,

@@ -1,4 +1,4 @@
-//! One level of the occupancy + reflectivity grid (Khan 2017 §3.4.1, spec §3.E).
+//! One level of the occupancy + reflectivity grid (Khan 2017 §3.4.1).
 //!
 //! A square grid of `width × height` cells of `resolution_m`; cell `(i, j)` covers
 //! `[x₀ + i·res, x₀ + (i+1)·res) × [y₀ + j·res, y₀ + (j+1)·res)` in the map frame (REP-103,
@@ -8,11 +8,12 @@
 //!   `L += logit(0.4)` in the cells the beam crosses (Bresenham), each cell at most once per
 //!   scan, clamped to ±[`LOG_ODDS_LIMIT`] (Hector's limit of 50);
 //! * the incremental mean of relative reflectivity `R_m(g) ← R_m(g) + (ϱ̄ − R_m(g)) / n_g`
-//!   over the end points that fall into the cell (spec §3.E), with its count `n_g`.
+//!   over the end points that fall into the cell (§3.4.1), with its count `n_g`.
 //!
 //! Sampling ([`GridLevel::occupancy`], [`GridLevel::reflectivity`]) is the consistent
 //! bilinear interpolation of the four surrounding cell centres with its analytic gradient
-//! (per metre) — the corrected form of the thesis' formulas (spec §3.E, both FLAGs).
+//! (per metre) — the corrected form of the thesis' formulas (§3.4.1: the printed value formula
+//! permutes the four weights, and the `∂R/∂y` denominator reads `x_i − x_i` for `x_j − x_i`).
 
 /// Hector's clamp of the log-odds (`GridMapLogOddsFunctions`: ±50).
 pub const LOG_ODDS_LIMIT: f32 = 50.0;
@@ -154,7 +155,7 @@ impl GridLevel {
     #[inline]
     fn bilinear(&self, v: [f64; 4], u: f64, w: f64) -> Sample {
         let [p00, p10, p01, p11] = v;
-        // Consistent bilinear form (spec §3.E FLAG): weights (1−u)(1−v), u(1−v), (1−u)v, uv.
+        // Consistent bilinear weights (1−u)(1−v), u(1−v), (1−u)v, uv (the thesis permutes them).
         let value =
             (1.0 - u) * (1.0 - w) * p00 + u * (1.0 - w) * p10 + (1.0 - u) * w * p01 + u * w * p11;
         // Its derivatives (the thesis' gradient up to 1/cell size).
@@ -180,7 +181,7 @@ impl GridLevel {
 
     /// Reflectivity R(P) at `(x, y)` with its gradient. Unobserved cells count as
     /// `unobserved` when it is `Some`; with `None` a sample touching an unobserved cell is
-    /// `None` (spec §3.E, the two options).
+    /// `None` (the thesis leaves unobserved cells open).
     #[inline]
     pub fn reflectivity(&self, x: f64, y: f64, unobserved: Option<f64>) -> Option<Sample> {
         let (k, u, w) = self.corners(x, y)?;
@@ -251,7 +252,7 @@ impl GridLevel {
         self.mark(cell.0, cell.1, delta, base, base + 1);
     }
 
-    /// Adds a reflectivity observation to a cell (incremental mean, spec §3.E).
+    /// Adds a reflectivity observation to a cell (incremental mean, §3.4.1).
     pub(crate) fn add_reflectivity(&mut self, cell: (usize, usize), reflectivity: f64) {
         if self.refl_count.is_empty() {
             self.refl_mean = vec![0.0; self.width * self.height];
@@ -260,7 +261,7 @@ impl GridLevel {
         let k = self.index(cell.0, cell.1);
         if let (Some(n), Some(m)) = (self.refl_count.get_mut(k), self.refl_mean.get_mut(k)) {
             *n = n.saturating_add(1);
-            // R_m ← R_m + (ϱ̄ − R_m) / n_g  (spec §3.E)
+            // R_m ← R_m + (ϱ̄ − R_m) / n_g  (§3.4.1)
             *m += (reflectivity as f32 - *m) / *n as f32;
         }
     }

@@ -1,6 +1,6 @@
 //! # raypath-reflectivity
 //!
-//! Laser intensities for 2-D SLAM after Khan (2017, ch. 3; spec `khan-2017.md` §3): an
+//! Laser intensities for 2-D SLAM after Khan (2017, ch. 3): an
 //! intensity calibration that turns raw remissions into a pose-invariant **relative
 //! reflectivity** `ϱ̄ = I / I_ref(r, α)`, and a Hector-SLAM-style front-end (Kohlbrecher et
 //! al., SSRR 2011) whose grid stores occupancy **and** the mean reflectivity per cell, matched
@@ -22,14 +22,14 @@
 //! Units and frames: metres, radians, seconds; REP-103 (x forward, y left, θ
 //! counter-clockwise). The first scan is placed at the map origin (identity), as in Hector.
 //!
-//! ## Errata and decisions (spec §3 FLAGs and [NOT IN THESIS] items)
+//! ## Errata and decisions (where the thesis is inconsistent or silent)
 //!
 //! * The printed bilinear *value* formula permutes its weights; we use the consistent
 //!   `(1−u)(1−v)R_i + u(1−v)R_j + (1−u)vR_k + uvR_l` and its derivatives, in metres
 //!   (cell values sit at cell centres).
 //! * `H = Σ JᵢᵀJᵢ` and `Δζ = H⁻¹ Σ Jᵢᵀ rᵢ` (the thesis writes the sum outside `H⁻¹`).
 //! * Unobserved cells have reflectivity 0 by default ([`MatcherConfig::unobserved_reflectivity`];
-//!   the spec's alternative "skip the beam" is `None`).
+//!   the alternative, skipping the beam, is `None`).
 //! * Only end-point cells receive reflectivity updates. Normals of 2-D scans: PCA over ±3
 //!   beams within 0.3 m. LUT steps 0.01 m × 0.5°; outside the samples' hull the nearest
 //!   sample's value (flagged).

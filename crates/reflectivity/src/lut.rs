@@ -1,11 +1,11 @@
-//! The intensity look-up table `I_ref(r, α)` (Khan 2017 §3.3.2, eqs. (3.4)–(3.5); spec §3.C).
+//! The intensity look-up table `I_ref(r, α)` (Khan 2017 §3.3.2, eqs. (3.4)–(3.5)).
 //!
 //! 1. The reference surface's samples `(r, α, I)` are triangulated (Delaunay, `spade`) in the
 //!    normalised `(r, α)` plane and interpolated linearly inside each triangle with
 //!    barycentric weights ([`ScatteredLinear`]: MATLAB `scatteredInterpolant(…, 'linear')`).
 //! 2. The interpolant is sampled on a regular grid ([`LutConfig`]: Δr = 0.01 m, Δα = 0.5° by
-//!    default, spec §3.C) over the samples' bounding box; grid nodes outside the convex hull
-//!    take the value of the nearest sample (clamping, spec §3.C) and are flagged.
+//!    default; the thesis gives no steps) over the samples' bounding box; grid nodes outside
+//!    the convex hull take the value of the nearest sample (clamping) and are flagged.
 //! 3. Online, [`IntensityLut::lookup`] interpolates the table bilinearly (ranges and angles
 //!    outside the table are clamped to its border), and ϱ̄ = I / I_ref(r, α).
 
@@ -141,7 +141,7 @@ impl ScatteredLinear {
     }
 }
 
-/// Table resolution (spec §3.C defaults: Δr = 0.01 m, Δα = 0.5°).
+/// Table resolution (defaults Δr = 0.01 m, Δα = 0.5°; the thesis gives no steps).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LutConfig {
     /// Range step, metres.

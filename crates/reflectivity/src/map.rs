@@ -13,7 +13,7 @@ use crate::grid::{GridLevel, logit};
 use crate::points::ScanPoints;
 
 /// Map parameters. Defaults: Hector's update factors (free 0.4, occupied 0.9) and three
-/// levels (spec §3.F, hector_mapping); the finest cell of 5 cm is the working point
+/// levels (hector_mapping; the thesis gives none); the finest cell is 5 cm, our working point
 /// (Hector's node defaults to 2.5 cm).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MapConfig {

@@ -1,5 +1,6 @@
 //! Gauss–Newton scan matching on the multi-resolution map (Kohlbrecher et al. 2011;
-//! Khan 2017 §3.4.2, eqs. (3.6)–(3.9), with the summed Hessian of the spec's FLAG).
+//! Khan 2017 §3.4.2, eqs. (3.6)–(3.9), with `H` summed over the beams: the thesis writes `H`
+//! for one beam and the sum outside `H⁻¹`).
 //!
 //! For the pose `ζ = (t_x, t_y, θ)` and end points `s_i` (sensor frame):
 //!
@@ -64,8 +65,9 @@ impl ResidualMode {
     }
 }
 
-/// Matcher parameters. Defaults follow hector_mapping (spec §3.F): 3 Gauss–Newton iterations
-/// on the coarser levels, 5 on the finest, map updates after 0.4 m or 0.9 rad of motion.
+/// Matcher parameters. Defaults follow hector_mapping (the thesis gives no levels or
+/// iterations): 3 Gauss–Newton iterations on the coarser levels, 5 on the finest, map updates
+/// after 0.4 m or 0.9 rad of motion.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MatcherConfig {
     /// The map.
@@ -84,8 +86,8 @@ pub struct MatcherConfig {
     pub max_rotation_step_rad: f64,
     /// Weight of the reflectivity residuals in [`ResidualMode::Combined`].
     pub reflectivity_weight: f64,
-    /// Reflectivity assumed for unobserved cells (`None`: skip such beams; spec §3.E).
-    /// Default 0: empty space reflects nothing, so the map's reflectivity also has edges
+    /// Reflectivity assumed for unobserved cells (`None`: skip such beams; the thesis leaves it
+    /// open). Default 0: empty space reflects nothing, so the map's reflectivity also has edges
     /// across surfaces.
     pub unobserved_reflectivity: Option<f64>,
     /// σ of the covariance `K = σ² H⁻¹` (sensor dependent; not given in the thesis).
@@ -316,7 +318,7 @@ fn normal_equations(
             grad[1],
             grad[0] * ds_dtheta[0] + grad[1] * ds_dtheta[1],
         );
-        h += j * j.transpose() * w; // H = Σ JᵢᵀJᵢ (spec FLAG: summed)
+        h += j * j.transpose() * w; // H = Σ JᵢᵀJᵢ (summed; the thesis prints one term)
         g += j * (residual * w);
     };
     for (p, &refl) in scan.points().iter().zip(scan.reflectivity()) {

@@ -1,5 +1,5 @@
 //! Surface normals by PCA and angles of incidence (Khan 2017 §3.3.1: "the eigenvector of the
-//! smallest eigenvalue of the neighbourhood covariance matrix", after Rusu; spec §3.C).
+//! smallest eigenvalue of the neighbourhood covariance matrix", after Rusu).
 //!
 //! The angle of incidence is `α = arccos(|b̂ · n̂|)` ∈ [0, π/2], with `b̂` the unit beam
 //! direction from the sensor to the point; the sign of the normal does not matter.

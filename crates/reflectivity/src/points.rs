@@ -1,5 +1,5 @@
 //! A prepared scan for matching: end points in the sensor frame with their relative
-//! reflectivity ϱ̄ (the thesis' `z_t = {(s_i, ϱ̄_i)}`, spec §3.E).
+//! reflectivity ϱ̄ (the thesis' `z_t = {(s_i, ϱ̄_i)}`, Khan 2017 §3.4.1).
 
 use raypath_geometry::Scan2;
 
@@ -31,7 +31,7 @@ pub struct PointFilter {
 
 impl Default for PointFilter {
     /// 0.1 m … 30 m (a Hokuyo UTM-30LX or SICK LMS range), normals over ±3 beams within
-    /// 0.3 m (spec §3.C: k = 5–9 neighbours).
+    /// 0.3 m (k = 5–9 neighbours; the thesis does not say how 2-D normals are found).
     fn default() -> Self {
         Self {
             min_range_m: 0.1,
@@ -87,7 +87,7 @@ impl ScanPoints {
 
     /// Replaces the contents with the returns of `scan` that pass `filter`. With `correction`
     /// and intensities in the scan, each point gets ϱ̄ = correction(I, r, α), α from the 2-D
-    /// PCA normal over neighbouring returns (spec §3.C); otherwise `NaN`.
+    /// PCA normal over neighbouring returns (as Khan 2017 §3.3.1 for 3-D); otherwise `NaN`.
     pub fn fill_from_scan(
         &mut self,
         scan: &Scan2,

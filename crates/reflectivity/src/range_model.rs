@@ -1,4 +1,4 @@
-//! The range-only baseline (Khan 2017 §3.5.1, spec §3.D): a polynomial
+//! The range-only baseline (Khan 2017 §3.5.1): a polynomial
 //! `f(r) = Σ_{i=1}^{n+1} p_i r^{n+1−i}` fitted by least squares to the reference surface's
 //! intensity near normal incidence; the corrected value is `I / f(r)` (α is ignored).
 
@@ -20,7 +20,7 @@ pub struct RangePolynomial {
 impl RangePolynomial {
     /// Fits a polynomial of `degree` to the samples with `α ≤ max_incidence_rad` (all
     /// samples when fewer than `degree + 1` qualify). The thesis does not give the degree;
-    /// spec §3.D suggests 3–5.
+    /// 3–5 is a reasonable choice.
     pub fn fit(
         samples: &[CalibrationSample],
         degree: usize,

@@ -1,4 +1,4 @@
-//! Parameters of the Rtree grid (Khan 2017, §2.6 and Table "Parameters" of the spec §2.E).
+//! Parameters of the Rtree grid (Khan 2017, §2.5, with the values of the experiments, §2.6).
 
 /// The inverse sensor model (Khan 2017, §2.5.1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -14,10 +14,9 @@ pub enum SensorModel {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Selection {
     /// The thesis' selection: every end-point cell plus cells sampled at random along the
-    /// beams — here each de-duplicated traversed cell with probability `1 / spacing`, the
-    /// expected `len / (spacing · r)` samples per beam of the spec (the thesis gives no
-    /// number; the spec's default spacing is 10 base cubes). The end-point model uses end
-    /// points only.
+    /// beams — here each de-duplicated traversed cell with probability `1 / spacing`, i.e.
+    /// `len / (spacing · r)` expected samples per beam (the thesis gives no number; the
+    /// default spacing is 10 base cubes). The end-point model uses end points only.
     BeamSamples {
         /// Mean distance between samples, in base cubes (s ≥ 1).
         spacing_cells: f64,

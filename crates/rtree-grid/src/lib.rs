@@ -25,12 +25,12 @@
 //!   load ≤ ¾) maps a base-cube key to its cell, so a scan update is a hash probe, not an
 //!   R-tree descent. Keys missing from it search the tree only in the 16³ blocks a fused
 //!   cell touches (a count per block), so new cells elsewhere cost one tree insertion.
-//! * **Batched scans.** A scan is traversed once (exact voxel traversal on the lattice) into
-//!   a vector of packed keys — a small direct-mapped cache drops the repeats of neighbouring
-//!   beams — then sorted and de-duplicated (occupied wins over free, OctoMap's
-//!   `insertPointCloud` rule, spec §2.D) and applied; fused cells get one update per scan.
-//! * **Fusion only from selected cells** (§2.F.1): end-point cells plus traversed cells drawn
-//!   at random ([`Selection`]); only clamped candidates are kept.
+//! * **Batched scans.** A scan is traversed once (exact voxel traversal on the lattice) into a
+//!   vector of packed keys — a small direct-mapped cache drops the repeats of neighbouring beams —
+//!   then sorted and de-duplicated (occupied wins over free, OctoMap's `insertPointCloud` rule; the
+//!   thesis does not say) and applied; fused cells get one update per scan.
+//! * **Fusion only from selected cells** (§2.5.2, Fig. 2.6): end-point cells plus traversed cells
+//!   drawn at random ([`Selection`]); only clamped candidates are kept.
 //! * **Fused-cell look-ups without the tree.** Per 16³ block, a 64-bit mask of the 4³
 //!   sub-blocks fused cells touch; a direct-mapped cache (2¹⁶ slots) of the fused cell last
 //!   found per 4³ block; slabs of ≤ 64 base cubes checked cube by cube and larger ones
@@ -46,15 +46,16 @@
 //! `O(c log c)`, updates `O(c)` hash probes plus `O(M log_d N)` per new cell, and fusion
 //! `O(|T| · (log N + k))` for `|T|` selected cells and `k` leaves per slab query.
 //!
-//! # Errata and decisions (spec §2.F.4 flags)
+//! # Errata and decisions
 //!
 //! * A slab fuses only if it is **exactly tiled** by leaves lying completely inside it, all
 //!   clamped with the polarity of `g_i` — coverage and non-overlap checks the thesis omits.
 //! * The fused probability is the equal-weight mean over the cells (g_i included).
 //! * Cells removed earlier in the same pass are skipped; + before − per axis.
 //! * Beam samples: each de-duplicated traversed cell is a candidate with probability
-//!   `1 / spacing` (the spec's `⌈len / (s·r)⌉` random positions per beam give the same
-//!   expected number; drawing from the traversed cells needs no extra look-ups).
+//!   `1 / spacing` (the thesis samples cells at random along each beam by its length but gives
+//!   no number; `⌈len / (s·r)⌉` random positions per beam give the same expected number, and
+//!   drawing from the traversed cells needs no extra look-ups).
 //! * Fused cells are updated as a whole, as in the thesis (unless split, below).
 //! * M and d were lost with the figure legends: M = 8, d = ⌈0.4·M⌉ by default.
 //! * Beams longer than [`GridConfig::max_range_m`] are cut and free only (OctoMap's rule).

@@ -2,8 +2,7 @@
 //!
 //! Per-cell ray statistics and lidar sensor models for mapping and Monte-Carlo localization,
 //! after Schaefer (2020), *Lidar mapping and localization*, **ch. 7** ("decay-rate model")
-//! and **ch. 8** ("full map posteriors"); the equations are numbered as in the thesis and in
-//! the raypath spec `schaefer-2020-maps.md` (§3 = ch. 7, §4 = ch. 8, §7 = errata).
+//! and **ch. 8** ("full map posteriors"); the equations are numbered as in the thesis.
 //!
 //! ## The idea
 //!
@@ -87,39 +86,48 @@
 //! | setting | default | source |
 //! |---|---|---|
 //! | [`SensorRange`] | `r_min = 0`, `r_max = 80 m` | thesis silent; the CARMEN lasers report no-returns at 81.83 / 81.91 m |
-//! | [`MappingConfig::include_no_returns`] | `true` | spec A1 |
-//! | [`DecayRateConfig`] `min_rate_per_m` | `1e-3` | spec A3 (thesis gives none) |
-//! | [`DecayRateConfig`] `unknown_rate_per_m` | mean observed ML rate | spec A2 |
-//! | [`ReflectionConfig`] clamps | `μ ∈ [1e-3, 1 − 1e-3]`, unknown = mean ML value | mirrors A2/A3 |
-//! | [`BetaPosteriorConfig`], [`GammaPosteriorConfig`] `prior` | `None`: method of moments (Sec. 8.5) | spec §4.7, A9 |
+//! | [`MappingConfig::include_no_returns`] | `true` | thesis silent; *no-returns in mapping* below |
+//! | [`DecayRateConfig`] `min_rate_per_m` | `1e-3` | thesis gives none; *zero rates* below |
+//! | [`DecayRateConfig`] `unknown_rate_per_m` | mean observed ML rate | thesis gives none; *unobserved cells* below |
+//! | [`ReflectionConfig`] clamps | `μ ∈ [1e-3, 1 − 1e-3]`, unknown = mean ML value | as the two rows above |
+//! | [`BetaPosteriorConfig`], [`GammaPosteriorConfig`] `prior` | `None`: method of moments (Sec. 8.5) | Sec. 8.5; *prior moments* below |
 //! | [`LogOddsConfig`] | hit 0.7, miss 0.4, clamps 0.12 / 0.97 | OctoMap (Hornung et al. 2013) |
 //! | [`LikelihoodFieldConfig`] | `z_hit = z_rand = 0.5`, `σ_hit = 0.2 m`, max distance 2 m, `P(sup) = P(sub) = 0.05`, normalized per ray | AMCL defaults; normalization Sec. 7.6.2 |
 //! | [`OpticalDepthConfig`] | 360 directions, 1-cell spacing, blending of the two nearest directions | measured (below) |
 //!
 //! ## Errata and ambiguities: what is implemented
 //!
-//! * **E5** (Eq. 7.30–7.32 integrate over `v_i`, read `v_k`): the density of a return in cell
-//!   `k` divides `P(x(r) ∈ v_k)` by the length of the **chord of `v_k`** — and that chord is
-//!   **clipped to `[r_min, r_max]`**, so the cell straddling `r_max` puts its whole mass into
-//!   the measurable part and densities plus `P(sup)`, `P(sub)` sum to exactly one; chords
-//!   below `1e-6` cell edges (corner grazes) are raised to that value.
-//! * **A1**: in mapping, no-returns (and returns at or beyond `r_max`) are traced to `r_max`
-//!   as pure misses, adding path length but no hit — exact for both ML maps and conjugate
-//!   updates; `sub` readings are ignored (no factorizing likelihood).
-//! * **A2**: cells no ray crossed and space outside the grid use one "outside" value (mean
-//!   observed ML value; for the Gamma posterior a homogeneous medium of rate
-//!   `κ₀ = (α / c) ln(1 + c/β)`), so probabilities still sum to one off the map.
-//! * **A3**: `λ ≥ 1e-3 /m` over the whole map (a proper decay process), `μ` clamped.
-//! * **A6, A7** (inverse and ground-truth KL): σ = 0.05 m, positions only; normalized weighted
-//!   estimator over the same 50-sample disc — in the scoring code.
-//! * **A8**: the corridor's measurement, motion and the MLM floor are recorded in
-//!   `raypath_sim::corridor` and in the `mcl` evaluation.
-//! * **A9**: moments over observed cells with a finite ML value; when the moments admit no
-//!   Beta / Gamma the uniform Beta(1, 1) / an exponential Gamma(1, 1/E) is used.
-//! * **A10**: a scan's likelihood is the product of per-ray likelihoods, also under the map
-//!   posterior (the thesis's working assumption).
-//! * **A12**: log-odds maps are scored as a Bernoulli field with the Eq. 7.32 density, the
-//!   way the thesis scores occupancy-style maps.
+//! * **Eq. 7.30–7.32** print the integral over `v_i`; we read `v_k`: the density of a return in
+//!   cell `k` divides `P(x(r) ∈ v_k)` by the length of the **chord of `v_k`** — and that chord is
+//!   **clipped to `[r_min, r_max]`**, so the cell straddling `r_max` puts its whole mass into the
+//!   measurable part and densities plus `P(sup)`, `P(sub)` sum to exactly one; chords below `1e-6`
+//!   cell edges (corner grazes) are raised to that value.
+//! * **No-returns in mapping** (the thesis does not say how they enter the map): no-returns (and
+//!   returns at or beyond `r_max`) are traced to `r_max` as pure misses, adding path length but no
+//!   hit — exact for both ML maps and conjugate updates; `sub` readings are ignored (no factorizing
+//!   likelihood).
+//! * **Unobserved cells** (the thesis gives no decay rate for them): cells no ray crossed and space
+//!   outside the grid use one "outside" value (mean observed ML value; for the Gamma posterior a
+//!   homogeneous medium of rate `κ₀ = (α / c) ln(1 + c/β)`), so probabilities still sum to one off
+//!   the map.
+//! * **Zero rates** (a cell crossed but never hit has the ML rate 0, so a return in it would
+//!   have probability 0): `λ ≥ 1e-3 /m` over the whole map (a proper decay process), `μ`
+//!   clamped.
+//! * **KL divergences** (the thesis gives neither the ground-truth σ of Sec. 7.6.2 nor the
+//!   samples of Sec. 8.5.2): σ = 0.05 m (ch. 8's Applanix accuracy), positions only; a
+//!   normalized weighted estimator over the same 50-sample disc — in the scoring code.
+//! * **Simulated corridor** (Sec. 8.5.1 leaves open what one measurement of a voxel is): the
+//!   corridor's measurement, motion and the MLM floor are recorded in `raypath_sim::corridor` and
+//!   in the `mcl` evaluation.
+//! * **Prior moments** (Sec. 8.5 does not say which cells enter): moments over observed cells with
+//!   a finite ML value; when the moments admit no Beta / Gamma the uniform Beta(1, 1) / an
+//!   exponential Gamma(1, 1/E) is used.
+//! * **Scan likelihood**: a scan's likelihood is the product of per-ray likelihoods, also under
+//!   the map posterior (the thesis's working assumption; strictly, rays sharing cells are
+//!   correlated under the posterior).
+//! * **Occupancy maps** (ch. 9 only says "cumulate occupancy probabilities along rays"):
+//!   log-odds maps are scored as a Bernoulli field with the Eq. 7.32 density, the way the
+//!   thesis scores occupancy-style maps.
 //! * **Path lengths in fixed point**: `R_i` accumulates in `u64` units of `2^-32` m, so maps
 //!   built in parallel are bit-identical for any thread count; counters saturate.
 //! * Traversal edge cases: an endpoint outside the grid gives misses only; an endpoint on a

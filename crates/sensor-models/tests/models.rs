@@ -105,10 +105,11 @@ proptest! {
     }
 }
 
-/// Sec. 7.5.2: with equal in-cell lengths d (Assumption 1), λ_i = q_i / d (Eq. 7.25), and
-/// the decay-rate probability of reflecting in v_k tends to the reflection model's
-/// q_k Π (1 − q_i) (Eq. 7.26) as the q_i shrink; the gap is first order in q_k only (the
-/// in-cell decay that Eq. 7.26 ignores, erratum E6) and second order in the others.
+/// Sec. 7.5.2: with equal in-cell lengths d (Assumption 1), λ_i = q_i / d (Eq. 7.25), and the
+/// decay-rate probability of reflecting in v_k tends to the reflection model's q_k Π (1 − q_i)
+/// (Eq. 7.26) as the q_i shrink; the gap is first order in q_k only (the in-cell decay that
+/// Eq. 7.26 ignores: it treats the integrand as constant across v_k) and second order in the
+/// others.
 #[test]
 fn reflection_model_is_the_equal_length_limit() {
     let d = 0.5;
@@ -310,7 +311,7 @@ fn total_probability(model: &impl SensorModel<Planar>, grid: &Grid2, ray: &Ray2)
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(25))]
 
-    /// Spec Sec. 3.11 (iii): `P(sub) + ∫ p + P(sup) = 1` for random maps, for every model.
+    /// `P(sub) + ∫ p + P(sup) = 1` (Sec. 7.4.4) for random maps, for every model.
     #[test]
     fn probabilities_sum_to_one(seed in any::<u64>(), with_min in any::<bool>()) {
         let stats = random_stats(seed);
@@ -337,7 +338,7 @@ proptest! {
     }
 }
 
-/// Spec Sec. 3.11 (i): rays in a homogeneous medium with decay rate λ (ranges drawn from
+/// Rays in a homogeneous medium with decay rate λ (ranges drawn from
 /// Exp(λ), no-returns beyond r_max) give back λ.
 #[test]
 fn constant_medium_recovers_the_decay_rate() {

@@ -1,7 +1,6 @@
-//! The 1-D corridor of Schaefer (2020), chapter 8 ("localization in simulation", Sec. 8.5.1;
-//! spec: schaefer-2020-maps.md §4.8): N = 100 voxels with hidden ground-truth map values, a
-//! mapping phase that visits every voxel `n` times, and a localization phase with one
-//! observation per iteration along the corridor.
+//! The 1-D corridor of Schaefer (2020), chapter 8 ("localization in simulation", Sec. 8.5.1):
+//! N = 100 voxels with hidden ground-truth map values, a mapping phase that visits every voxel
+//! `n` times, and a localization phase with one observation per iteration along the corridor.
 //!
 //! # Models
 //!
@@ -12,21 +11,19 @@
 //!   the voxel: `t ~ Exp(λ_i)`; `t < 1` is a hit at depth `r = t`, otherwise a miss that
 //!   travels `r = 1`.
 //!
-//! # Decisions the spec leaves open (recorded here)
+//! # Decisions the thesis leaves open (recorded here)
 //!
 //! 1. **Voxel length** 1 m, so a miss travels 1 m and depths are in metres.
-//! 2. **A measurement** of a voxel is the draw above (spec §4.8 suggestion (a)). The mapping
-//!    statistics per voxel are `H_i` (hits), `M_i` (misses) and `R_i` (total in-voxel
-//!    distance: `Σ r`). Under REF the in-voxel distance carries no information; it is
-//!    recorded as 1 m for a miss and 0.5 m for a hit (the reflection at the voxel centre) so
-//!    that `R_i` is defined for both models.
+//! 2. **A measurement** of a voxel is the draw above. The mapping statistics per voxel are `H_i`
+//!    (hits), `M_i` (misses) and `R_i` (total in-voxel distance: `Σ r`). Under REF the in-voxel
+//!    distance carries no information; it is recorded as 1 m for a miss and 0.5 m for a hit (the
+//!    reflection at the voxel centre) so that `R_i` is defined for both models.
 //! 3. **Mapping order**: `n` passes along the corridor, one measurement of every voxel per
 //!    pass (pass-major), all from one random stream.
-//! 4. **Localization**: the robot starts before voxel 0 and iteration `t = 0 … N − 1` moves it
-//!    into voxel `t` and fires once: the observation of iteration `t` is one measurement of
-//!    voxel `t` (spec suggestion (b)); there are N = 100 iterations. The motion is known
-//!    (deterministic shift by one voxel); evaluating pose hypotheses is left to the
-//!    sensor-model evaluation.
+//! 4. **Localization**: the robot starts before voxel 0 and iteration `t = 0 … N − 1` moves it into
+//!    voxel `t` and fires once: the observation of iteration `t` is one measurement of voxel `t`;
+//!    there are N = 100 iterations. The motion is known (deterministic shift by one voxel);
+//!    evaluating pose hypotheses is left to the sensor-model evaluation.
 //! 5. **Random streams** (so evaluations can regenerate a run): run `r` of a data set with
 //!    seed `S` uses the world seed `w = stream(S, RUN, r)`'s first `u64`;
 //!    [`CorridorWorld::sample`]`(w, model)` draws the map from `stream(w, MAP, model)`; the

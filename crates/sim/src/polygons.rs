@@ -1,8 +1,8 @@
 //! The polyline benchmark of Schaefer (2020), chapter 10: random polygons seen by a 360° scanner
 //! at their centre, with noisy ray angles and ranges and the ground-truth polygon kept.
 //!
-//! The protocol follows the thesis and its reference implementation (`polygon.rand(c, s)` of
-//! `acschaefer/ple`; spec: schaefer-2020-features.md §1.7 "Simulated data"):
+//! The protocol follows the thesis (§10.5, the simulated scans) and its reference
+//! implementation (`polygon.rand(c, s)` of `acschaefer/ple`):
 //!
 //! * the number of vertices `n` is drawn uniformly from {3, 4, 5, 6, 12, 36, 180};
 //! * vertex angles are `U + linspace(0, 2π(1 − 1/n), n)` with `U ~ U(0, 1)` (radians);
@@ -13,10 +13,11 @@
 //!   the polygon along its noisy direction, and its range gets Gaussian noise (σ = 0.03 m);
 //!   the scan records the nominal angles, as a real scanner does.
 //!
-//! **Erratum.** The thesis lays the rays out as `linspace(−180°, 180°, 360)`, which makes the
-//! first and the last ray coincide (−180° = +180°) and spaces the others 360°/359 apart. By
-//! default the rays are spaced 1° over [−180°, 180°) instead ([`AzimuthLayout::HalfOpen`]);
-//! [`AzimuthLayout::ThesisLinspace`] reproduces the thesis layout.
+//! **Erratum.** The reference implementation behind the thesis' results lays the rays out as
+//! `linspace(−180°, 180°, 360)`, which makes the first and the last ray coincide (−180° =
+//! +180°) and spaces the others 360°/359 apart. By default the rays are spaced 1° over
+//! [−180°, 180°) instead ([`AzimuthLayout::HalfOpen`]); [`AzimuthLayout::ThesisLinspace`]
+//! reproduces that layout.
 //!
 //! **Output.** One CARMEN log `polygons.log` of `ROBOTLASER1` messages (they state the start
 //! angle, field of view and resolution, so a 360° scan is unambiguous), one per polygon, with
@@ -54,8 +55,9 @@ pub enum AzimuthLayout {
     /// Ray `i` at −180° + i·360°/n: equally spaced, none repeated (default).
     #[default]
     HalfOpen,
-    /// The thesis layout `linspace(−180°, 180°, n)`: ray `i` at −180° + i·360°/(n − 1), the
-    /// first and the last ray coincide.
+    /// The layout of the thesis' experiments (its reference implementation)
+    /// `linspace(−180°, 180°, n)`: ray `i` at −180° + i·360°/(n − 1), the first and the last
+    /// ray coincide.
     ThesisLinspace,
 }
 

@@ -3,8 +3,7 @@
 //! The format is the log format of the CARMEN robot navigation toolkit (Montemerlo, Roy and
 //! Thrun, IROS 2003; <http://carmen.sourceforge.net>), in which the Radish repository (Howard
 //! and Roy, 2003) and the SLAM benchmark collection distribute their indoor logs. Files are
-//! plain text, `.gz` or `.bz2` (recognized by their first bytes). The messages read here
-//! (see Schaefer 2020, thesis section 5.1 of the feature spec):
+//! plain text, `.gz` or `.bz2` (recognized by their first bytes). The messages read here:
 //!
 //! ```text
 //! FLASER n r_1 … r_n x y theta odom_x odom_y odom_theta ipc_timestamp ipc_hostname logger_timestamp

@@ -3,8 +3,7 @@
 //!
 //! Formats as published with the data set (Carlevaris-Bianco, Ushani and Eustice, "University
 //! of Michigan North Campus long-term vision and lidar dataset", IJRR 2016;
-//! <http://robots.engin.umich.edu/nclt/>, scripts `read_vel_sync.py`, `read_vel_hits.py`),
-//! as summarized in the raypath spec (Schaefer 2020 features, section 5.4):
+//! <http://robots.engin.umich.edu/nclt/>, scripts `read_vel_sync.py`, `read_vel_hits.py`):
 //!
 //! ```text
 //! <date>/velodyne_data/<date>_vel/velodyne_sync/<utime>.bin  one revolution, 8-byte records

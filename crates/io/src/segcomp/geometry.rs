@@ -5,9 +5,8 @@ use nalgebra::{Point3, Vector3};
 /// The constants of the SegComp Perceptron range-to-Cartesian conversion.
 ///
 /// Source: `range-to-coords.c` of the USF segmentation-comparison distribution (Hoover et al.
-/// 1996), as used by the PPE reference implementation (`sc2cart`; spec
-/// `schaefer-2020-features.md` §5.2). For pixel (row `r`, column `c`) of an `nr × nc` image
-/// with raw range `ra` (12-bit counts):
+/// 1996), as used by the PPE reference implementation (`sc2cart`). For pixel (row `r`, column `c`)
+/// of an `nr × nc` image with raw range `ra` (12-bit counts):
 ///
 /// ```text
 /// α = α0 + H·(255.5 − c)/nc,   β = β0 + V·(255.5 − r)/nr        (degrees → radians)

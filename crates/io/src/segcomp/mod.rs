@@ -1,9 +1,9 @@
 //! SegComp (Hoover et al. 1996, "An experimental comparison of range image segmentation
 //! algorithms") Perceptron files: range images, ground-truth segmentations and angles.
 //!
-//! The benchmark is distributed as tar archives of Unix-`compress`ed files (spec
-//! `schaefer-2020-features.md` §5.2 and §2.9; 10 training and 30 test scans of polyhedral
-//! objects on a table, 512 × 512 pixels):
+//! The benchmark is distributed as tar archives of Unix-`compress`ed files (10 training and
+//! 30 test scans of polyhedral objects on a table, 512 × 512 pixels; the PPE experiments of
+//! Schaefer 2020, §11.5, use them):
 //!
 //! * `perc.{train,test}.N` — a range image: 10 ASCII header lines (line 1 holds the number of
 //!   rows, line 2 the number of columns) plus one more line, then `rows × columns` big-endian

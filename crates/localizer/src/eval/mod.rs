@@ -1,5 +1,5 @@
-//! Trajectory evaluation as in Schaefer (2020), ch. 12 (spec schaefer-2020-features §3.4,
-//! §3.5: the NCLT and KITTI protocols of the polex implementation).
+//! Trajectory evaluation as in Schaefer (2020), ch. 12 (§12.5.1, §12.5.2: the NCLT and KITTI
+//! protocols, as the polex implementation runs them).
 //!
 //! 1. The ground-truth track is projected onto the ground plane and its **arc length** is
 //!    accumulated. Evaluation points lie every [`EvaluationConfig::spacing_m`] (1 m) of arc
@@ -22,7 +22,7 @@
 //!    time diverged (each point weighted by half the time to its neighbours).
 //!
 //! [`relative_motion_errors`] adds the relative-motion (drift) error over pairs of poses a
-//! fixed arc length apart, for odometry and SLAM evaluations of later issues.
+//! fixed arc length apart, for odometry and SLAM evaluations.
 
 mod arc;
 mod relative;

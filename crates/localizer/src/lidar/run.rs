@@ -23,7 +23,7 @@ pub struct PlanarStep {
 }
 
 /// How [`track_planar`] runs the filter. Defaults follow ROS AMCL where the thesis is silent
-/// (erratum A4).
+/// (ch. 7 gives no motion model, resampling scheme, estimator or rays per scan).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrackConfig {
     /// Number of particles. Default 1000.

@@ -1,7 +1,7 @@
 //! A 6-DOF Gaussian increment model for SE(3).
 //!
 //! Schaefer (2020, ch. 7 and 8) localizes in six dimensions but does not state the motion
-//! model (erratum A4 of the maps spec); this is ours. Given the body-frame odometry increment
+//! model; this is ours. Given the body-frame odometry increment
 //! Δ = (Δt, ΔR) with translation length d = ‖Δt‖ (m) and rotation angle a = ∠ΔR (rad), the
 //! particle moves by the perturbed increment
 //!

@@ -7,8 +7,8 @@
 //! | [`Gaussian6DofMotionModel`] | SE(3) | [`Pose3`](raypath_geometry::Pose3) increment | ours (ch. 7 leaves it open) |
 //!
 //! All increments are **body-frame**: the new particle is `x' = x · Δ̃` with the noisy increment
-//! Δ̃ (right multiplication, erratum 16 of the features spec: the thesis prints `Δ · x`, the
-//! reference implementation and the physics of relative odometry use `x · Δ`).
+//! Δ̃ (right multiplication: Schaefer 2020, §12.4.3, prints `Δ · x`; the reference
+//! implementation and the physics of relative odometry use `x · Δ`).
 //! [`crate::PoseTrack::increment`] computes Δ between two time stamps from an odometry track.
 
 mod gaussian3;

@@ -7,7 +7,8 @@
 //!
 //! with χ and Σ the odometry increment and its covariance (NCLT provides both) and s a
 //! variance scale (the thesis inflates NCLT's covariance by s = 2² = 4, i.e. doubles the
-//! standard deviations). Composition on the right (body frame), erratum 16.
+//! standard deviations). Composition on the right (body frame), as the reference implementation;
+//! the thesis prints `transform(ξ) · X_{t−1}`.
 
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use rand::Rng;

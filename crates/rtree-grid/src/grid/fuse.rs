@@ -1,5 +1,6 @@
-//! Cell fusion, `Fuse(g_i)` of Khan 2017, Fig. 2.7, with the coverage and non-overlap
-//! checks of the spec's flagged rule (§2.F.4).
+//! Cell fusion, `Fuse(g_i)` of Khan 2017, Fig. 2.7, with coverage and non-overlap checks that
+//! the fusion conditions (Eqs. 2.9–2.11, §2.5.2) omit: as printed, a fused cuboid could
+//! swallow unknown space or overlap a neighbouring cell.
 
 use super::{RtreeGrid, SensorModel};
 use crate::config::FusionRule;
@@ -64,7 +65,7 @@ impl RtreeGrid {
                 return steps;
             }
             if self.config.model == SensorModel::BeamEndPoint && cell.log_odds <= self.l_threshold {
-                return steps; // §2.F.6: only occupied fusion
+                return steps; // §2.5.2, beam-end-point model: only occupied fusion
             }
             let mut fused = None;
             for direction in search_order(cell.bx.widths()) {

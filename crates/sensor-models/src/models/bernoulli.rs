@@ -20,13 +20,13 @@ pub(crate) const MIN_CHORD_FRACTION: f64 = 1e-6;
 /// ```
 ///
 /// `B(k)`: the cells the ray crosses (with positive length) before the endpoint cell `v_k`;
-/// `chord_k`: the part of the ray's line inside `v_k` that the sensor can measure, i.e. the
-/// chord clipped to `[r_min, r_max]` (spec erratum E5: the integral of Eq. 7.30–7.32 runs
+/// `chord_k`: the part of the ray's line inside `v_k` that the sensor can measure, i.e. the chord
+/// clipped to `[r_min, r_max]` (the thesis prints the integral of Eq. 7.30–7.32 over `v_i`; it runs
 /// over `v_k`). Clipping makes the probabilities sum to exactly one: the cell that straddles
 /// `r_max` gets its full mass as density, and the cell that straddles `r_min` counts to the
-/// in-range part, so `B(r_min)` holds the cells the ray has left before `r_min`. Outside the
-/// grid the ray crosses virtual cells of edge `c` with the outside probability `μ₀`: it
-/// loses `ln(1 − μ₀)` per `c` metres, and an endpoint there has density `μ₀ / c`.
+/// in-range part, so `B(r_min)` holds the cells the ray has left before `r_min`. Outside the grid
+/// the ray crosses virtual cells of edge `c` with the outside probability `μ₀`: it loses
+/// `ln(1 − μ₀)` per `c` metres, and an endpoint there has density `μ₀ / c`.
 ///
 /// [`crate::ReflectionModel`] and [`crate::LogOddsModel`] build this field from counts.
 #[derive(Clone, Debug)]

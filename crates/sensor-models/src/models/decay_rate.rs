@@ -9,7 +9,7 @@ use crate::{MomentStatistics, Reading, SensorModelError, SensorRange};
 
 /// Configuration of [`DecayRateModel`].
 ///
-/// Defaults (spec decisions A2, A3; the thesis gives no values):
+/// Defaults (ours; the thesis gives no values):
 /// * `min_rate_per_m = 1e-3` — floor of every cell's λ. A cell crossed but never hit has
 ///   the ML value λ = 0 (Eq. 7.10), so a ray ending there would get `ln 0 = −∞`; the floor
 ///   applies to the whole map (not only to the endpoint), so the model stays a proper

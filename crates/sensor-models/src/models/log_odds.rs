@@ -89,7 +89,7 @@ fn logit(p: f64) -> f64 {
 /// **Ray likelihood.** An occupancy grid has no measurement model of its own. We use the
 /// reflection-model form with `p_occ` in place of μ (Eq. 7.23 with the density conversion
 /// Eq. 7.32), the way the thesis scores occupancy-style maps (GPOM and Hilbert maps in
-/// ch. 9: "cumulate occupancy probabilities along rays", spec A12):
+/// ch. 9: "cumulate occupancy probabilities along rays"):
 /// `ln p(r) = ln p_k + Σ_{i ∈ B(k)} ln(1 − p_i) − ln |chord_k|`. Unobserved cells and space
 /// outside the grid have `p = 0.5`.
 #[derive(Clone, Debug)]

@@ -5,8 +5,8 @@ use serde::{Deserialize, Serialize};
 use crate::SensorModelError;
 use crate::stats::CellStats;
 
-/// Mean and variance of a map's ML cell values, over the cells that enter the estimate
-/// (spec decision A9: observed cells with a finite ML value).
+/// Mean and variance of a map's ML cell values, over the cells that enter the estimate (observed
+/// cells with a finite ML value; Sec. 8.5 does not say which cells enter).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MomentStatistics {
     /// Number of cells.
@@ -132,8 +132,8 @@ impl Default for GammaPrior {
 }
 
 impl GammaPrior {
-    /// A prior with α, β > 0 (finite). β > 0 is required: with the "uninformative"
-    /// β = 0 an unobserved cell blocks every ray (spec Sec. 4.6).
+    /// A prior with α, β > 0 (finite). β > 0 is required: with the "uninformative" β = 0 an
+    /// unobserved cell blocks every ray (the closed-form likelihood of Sec. 8.4.5).
     pub fn new(alpha: f64, beta: f64) -> Result<Self, SensorModelError> {
         if !(alpha.is_finite() && beta.is_finite() && alpha > 0.0 && beta > 0.0) {
             return Err(SensorModelError::InvalidParameter {

@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 use crate::SensorModelError;
 
 /// How the scans of a log are split into a mapping set and a disjoint test set (the thesis
-/// keeps them disjoint but does not say how, Sec. 7.6; spec §3.9).
+/// keeps them disjoint but does not say how, Sec. 7.6).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Split {
     /// Even-indexed scans build the map, odd-indexed scans are scored (the default): both
@@ -54,11 +54,11 @@ impl Split {
 ///   a wall is one or two cells thick). 3-D callers pass 0.5 m as the thesis did.
 /// * `split = Alternate`, `max_range_m = None` (the smallest `max_range_m` of the scans,
 ///   i.e. the no-return threshold that `raypath-io` inferred for the log).
-/// * `poses_per_scan = 50`, `disc_radius_m = 2.5` (Sec. 7.6.2), `ground_truth_sigma_m =
-///   0.05` (ch. 8's Applanix σ, spec decision A6); only the position is perturbed, heading
-///   (and height and attitude in 3-D) stay at the truth; the true pose is **not** one of the
-///   samples (the thesis samples uniformly in the disc; adding the truth would hand every
-///   model the exact answer as a candidate).
+/// * `poses_per_scan = 50`, `disc_radius_m = 2.5` (Sec. 7.6.2), `ground_truth_sigma_m = 0.05`
+///   (ch. 8's Applanix σ; Sec. 7.6.2 gives none); only the position is perturbed, heading (and
+///   height and attitude in 3-D) stay at the truth; the true pose is **not** one of the samples
+///   (the thesis samples uniformly in the disc; adding the truth would hand every model the exact
+///   answer as a candidate).
 /// * `seed = 0` — the samples of test scan `i` come from a generator seeded with
 ///   `(seed, i)`, the same samples for every model.
 /// * `beam_step = 1`, `max_test_scans = None` — every beam of every test scan (the thesis's

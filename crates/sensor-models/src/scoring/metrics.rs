@@ -44,7 +44,7 @@ pub fn disc_offsets(seed: u64, scan_index: u64, count: usize, radius_m: f64) -> 
 pub struct Divergences {
     /// `D(h‖g) = Σ_i p̂_i ln(p̂_i / ĝ_i)` (Eq. 7.29).
     pub inverse_kl: f64,
-    /// `D_KL(p_gt‖p) = Σ_i ĝ_i ln(ĝ_i / p̂_i)` (Eq. 8.24, estimator of spec A7).
+    /// `D_KL(p_gt‖p) = Σ_i ĝ_i ln(ĝ_i / p̂_i)` (Eq. 8.24, with the estimator of the module docs).
     pub kl_ground_truth: f64,
 }
 

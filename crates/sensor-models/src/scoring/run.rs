@@ -111,13 +111,12 @@ pub fn score_log(
 /// traversal, corrected poses), every model variant from them, and scores the `test`
 /// scans (poses `world_from_laser`).
 ///
-/// The grid covers everything the mapping rays traversed (each ray up to its return, or up
-/// to `r_max` for a no-return) and all poses (map and test) with `margin_m +
-/// disc_radius_m` around them, so that the no-returns of the test scans cross mapped space
-/// rather than the models' "outside the grid" prior (spec A2), which would otherwise
-/// dominate their scores. The range limit is `config.max_range_m` or
-/// the smallest `max_range_m` of the scans. Work is parallel over test scans (rayon) and
-/// the result does not depend on the thread count.
+/// The grid covers everything the mapping rays traversed (each ray up to its return, or up to
+/// `r_max` for a no-return) and all poses (map and test) with `margin_m + disc_radius_m` around
+/// them, so that the no-returns of the test scans cross mapped space rather than the models'
+/// "outside the grid" prior, which would otherwise dominate their scores. The range limit is
+/// `config.max_range_m` or the smallest `max_range_m` of the scans. Work is parallel over test
+/// scans (rayon) and the result does not depend on the thread count.
 pub fn score_planar(
     map: &[(Pose2, &Scan2)],
     test: &[(Pose2, &Scan2)],

@@ -6,13 +6,12 @@ use crate::{SensorModelError, SensorRange};
 
 /// Configuration of map building (algorithm MAP-DECAY, Schaefer 2020, Sec. 7.4.2).
 ///
-/// Defaults ([`MappingConfig::default`]): the default [`SensorRange`] (`r_min = 0`,
-/// `r_max = 80 m`) and no-returns included (spec decision A1: a `sup` ray is traced to
-/// `r_max` and adds path length and misses, no hit; with it the closed-form ML map
-/// `λ_i = H_i / R_i` still maximizes the likelihood of all rays, because
-/// `ln P(sup) = −Σ λ_i d_i` is linear in λ). `sub` readings (returns below `r_min`) are
-/// always ignored in mapping: `ln P(sub) = ln(1 − e^{−Σ λ_i d_i})` has no closed-form
-/// maximizer and is not a factorizing likelihood (ch. 8), so it admits no conjugate
+/// Defaults ([`MappingConfig::default`]): the default [`SensorRange`] (`r_min = 0`, `r_max = 80 m`)
+/// and no-returns included (the thesis is silent on them: a `sup` ray is traced to `r_max` and adds
+/// path length and misses, no hit; with it the closed-form ML map `λ_i = H_i / R_i` still maximizes
+/// the likelihood of all rays, because `ln P(sup) = −Σ λ_i d_i` is linear in λ). `sub` readings
+/// (returns below `r_min`) are always ignored in mapping: `ln P(sub) = ln(1 − e^{−Σ λ_i d_i})` has
+/// no closed-form maximizer and is not a factorizing likelihood (ch. 8), so it admits no conjugate
 /// update.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MappingConfig {

@@ -1,13 +1,12 @@
 //! Simulated laser intensities (remissions) from surface reflectivity, range and angle of
 //! incidence.
 //!
-//! Khan (2017, ch. 3; spec khan-2017.md §3.A–3.C) finds that real 2-D scanners (Hokuyo
-//! UTM-30LX, SICK LMS 291) do **not** follow the Lambertian lidar equation `I ∝ ρ cos α / r²`:
-//! the intensity *drops* at short range ("near-distance effect"), and the fall-off with the
-//! angle of incidence is not `cos α` and changes with range, so the joint model
-//! `I = ρ · f(r, α)` (eq. 3.3) is needed, calibrated as a look-up table. The simulated model
-//! has both effects so that a calibration has something to recover, while staying a
-//! closed-form ground truth ([`IntensityModel::expected`]):
+//! Khan (2017, §3.3) finds that real 2-D scanners (Hokuyo UTM-30LX, SICK LMS 291) do **not** follow
+//! the Lambertian lidar equation `I ∝ ρ cos α / r²`: the intensity *drops* at short range
+//! ("near-distance effect"), and the fall-off with the angle of incidence is not `cos α` and
+//! changes with range, so the joint model `I = ρ · f(r, α)` (eq. 3.3) is needed, calibrated as a
+//! look-up table. The simulated model has both effects so that a calibration has something to
+//! recover, while staying a closed-form ground truth ([`IntensityModel::expected`]):
 //!
 //! ```text
 //! I = clip( gain · ρ · h(r) · cos(α)^(p₀ + p₁·r) · (1 + ε_rel) + ε_abs,  0, saturation )

@@ -17,10 +17,10 @@
 //! | tree trunk | 0.1–0.4 m (0.1 + 0.3u²) | 2–4 m to the crown; crown 1.5–4 m radius | half of the street sides, every 8–14 m |
 //! | bollard | 0.05–0.1 m | 0.8–1.2 m | groups of 3–6, 1.2–1.8 m apart |
 //!
-//! Poles keep at least 1 m between each other, so the free hull the extractor needs around a
-//! pole (spec §3.1) is there. Parked cars (3.8–5 m × 1.7–1.95 m × 1.4–1.75 m; body, cabin,
-//! wheels) fill 30–75 % of the parking slots; construction zones hold rows of barrels
-//! (r 0.29 m, 1.05 m high) in a parking lane.
+//! Poles keep at least 1 m between each other, so the free hull the extractor needs around a pole
+//! (Schaefer 2020, §12.4.1) is there. Parked cars (3.8–5 m × 1.7–1.95 m × 1.4–1.75 m; body, cabin,
+//! wheels) fill 30–75 % of the parking slots; construction zones hold rows of barrels (r 0.29 m,
+//! 1.05 m high) in a parking lane.
 //!
 //! ## Drives and sessions
 //!
