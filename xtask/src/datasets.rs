@@ -80,7 +80,7 @@ pub fn run(json: bool) -> Result<()> {
         };
         table.row([set.id.clone(), status, set.layout.clone()]);
     }
-    print!("{}", table.to_markdown());
+    print!("{}", table.to_markdown()?);
     let missing: Vec<_> = rows.iter().filter(|(_, s, _)| *s != "found").collect();
     if !missing.is_empty() {
         println!("\nWhere to get what is missing:\n");

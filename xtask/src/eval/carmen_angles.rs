@@ -304,7 +304,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         bar.inc(1);
     }
     bar.finish_and_clear();
-    Ok(report(&results, &pictures, stride))
+    report(&results, &pictures, stride)
 }
 
 fn best_index(scores: &[Score]) -> usize {
@@ -320,7 +320,11 @@ fn runner_up(scores: &[Score], best: usize) -> usize {
         .unwrap_or(0)
 }
 
-fn report(results: &[LogResult], pictures: &[(String, String)], stride: usize) -> EvalReport {
+fn report(
+    results: &[LogResult],
+    pictures: &[(String, String)],
+    stride: usize,
+) -> Result<EvalReport> {
     let mut headers = vec![
         "log".to_owned(),
         "beams".into(),
@@ -465,9 +469,9 @@ fn report(results: &[LogResult], pictures: &[(String, String)], stride: usize) -
          the step).\n\n",
     );
     md.push_str("### Occupied 5 cm cells (fewer is crisper)\n\n");
-    md.push_str(&cells_table.to_markdown());
+    md.push_str(&cells_table.to_markdown()?);
     md.push_str("\n### Entropy of the hit histogram in bits (lower is crisper)\n\n");
-    md.push_str(&entropy_table.to_markdown());
+    md.push_str(&entropy_table.to_markdown()?);
     md.push_str(
         "\n### Sweep of the first and last beam\n\nA finer check that the winner is not just \
          the least wrong of three guesses: the first and the last beam are moved in half \
@@ -475,7 +479,7 @@ fn report(results: &[LogResult], pictures: &[(String, String)], stride: usize) -
          and the fan in between is spread evenly, 25 layouts per log. \"nominal\" is the \
          `Auto` layout (beam `i` at −90° + i·step).\n\n",
     );
-    md.push_str(&sweep_table.to_markdown());
+    md.push_str(&sweep_table.to_markdown()?);
     md.push_str(&format!(
         "\n**Verdict.** Even beam counts (180, 360): `{even_name}` wins {even_wins} of \
          {even_logs} logs. Odd beam counts (181, 361): `{odd_name}` wins {odd_wins} of \
@@ -502,7 +506,7 @@ fn report(results: &[LogResult], pictures: &[(String, String)], stride: usize) -
             ));
         }
     }
-    EvalReport {
+    Ok(EvalReport {
         name: "carmen-angles",
         title: "CARMEN beam-angle convention checked by map sharpness".into(),
         markdown: md,
@@ -514,5 +518,5 @@ fn report(results: &[LogResult], pictures: &[(String, String)], stride: usize) -
             "logs": json_logs,
         }),
         headline: None,
-    }
+    })
 }

@@ -425,7 +425,7 @@ pub fn section(ctx: &EvalContext) -> Result<(String, serde_json::Value)> {
         markdown.push_str(&format!(
             "### {label}\n\n{}\nOurs and the thesis agree on the significance for {agree} of {} \
              values of n.\n\n",
-            table.to_markdown(),
+            table.to_markdown()?,
             cells.len()
         ));
         json_models.insert(

@@ -301,7 +301,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          were measured side by side.\n",
         load_average()
     );
-    md.push_str(&report_markdown(ctx, &cells, &infos, sizes));
+    md.push_str(&report_markdown(ctx, &cells, &infos, sizes)?);
     let json_cells: Vec<_> = cells
         .iter()
         .map(|c| {
@@ -351,7 +351,7 @@ fn report_markdown(
     cells: &[Cell],
     infos: &[serde_json::Value],
     sizes: &[usize],
-) -> String {
+) -> Result<String> {
     let mut md = String::new();
     let _ = writeln!(
         md,
@@ -389,7 +389,7 @@ fn report_markdown(
             i["truth_observed_cells"].to_string(),
         ]);
     }
-    md.push_str(&t.to_markdown());
+    md.push_str(&t.to_markdown()?);
     let thesis = |n: usize| THESIS.iter().find(|t| t.0 == n);
 
     let _ = writeln!(
@@ -444,7 +444,7 @@ fn report_markdown(
             format!("{wins}/{}", d.len()),
         ]);
     }
-    md.push_str(&t.to_markdown());
+    md.push_str(&t.to_markdown()?);
 
     let _ = writeln!(
         md,
@@ -491,7 +491,7 @@ fn report_markdown(
             format!("{}/{}", d.iter().filter(|v| **v > 0.0).count(), d.len()),
         ]);
     }
-    md.push_str(&t.to_markdown());
+    md.push_str(&t.to_markdown()?);
 
     let _ = writeln!(md, "\n## Table 9.4 — mapping time [s], median over logs\n");
     let _ = writeln!(
@@ -536,7 +536,7 @@ fn report_markdown(
             fmt_num(med(&|c| c.iterations as f64), 0),
         ]);
     }
-    md.push_str(&t.to_markdown());
+    md.push_str(&t.to_markdown()?);
 
     let _ = writeln!(md, "\n## Per log\n");
     let mut t = Table::new([
@@ -565,7 +565,7 @@ fn report_markdown(
             c.iterations.to_string(),
         ]);
     }
-    md.push_str(&t.to_markdown());
+    md.push_str(&t.to_markdown()?);
     if cells.iter().any(|c| c.log == "intel") {
         let _ = writeln!(md, "\n## Fig. 9.1 — Intel Research Lab patch\n");
         let _ = writeln!(
@@ -580,7 +580,7 @@ fn report_markdown(
             );
         }
     }
-    md
+    Ok(md)
 }
 
 const TIMING_RUNS_TEXT: &str = "the first 500 mapping rays (one run)";

@@ -373,7 +373,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         } else {
             ", 100 000 rays per case"
         },
-        table = table.to_markdown(),
+        table = table.to_markdown()?,
         before = fmt_load(load_before),
         after = fmt_load(load_after),
         cores = std::thread::available_parallelism().map_or(1, usize::from),

@@ -138,7 +138,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         ]);
     }
     markdown.push_str("## Throughput per format\n\n");
-    markdown.push_str(&table.to_markdown());
+    markdown.push_str(&table.to_markdown()?);
 
     // Per file.
     let mut table = Table::new([
@@ -169,7 +169,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         ]);
     }
     markdown.push_str("\n## Files\n\n");
-    markdown.push_str(&table.to_markdown());
+    markdown.push_str(&table.to_markdown()?);
 
     if !failures.is_empty() || !unknown.is_empty() || !unsupported.is_empty() {
         markdown.push_str("\n## Not read\n\n");

@@ -239,7 +239,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         frames_3d,
         map_rays_3d,
         &corridor_markdown,
-    );
+    )?;
     let json = json!({
         "settings": {
             "seeds": s.seeds, "ground_truth_scans_per_log": s.gt_scans,
@@ -330,7 +330,7 @@ fn report_markdown(
     frames_3d: usize,
     map_rays_3d: u64,
     corridor_markdown: &str,
-) -> String {
+) -> Result<String> {
     let mut md = String::new();
     let mode = if ctx.quick {
         format!(
@@ -383,7 +383,7 @@ fn report_markdown(
             fmt_num(c.updates_per_s(), 0),
         ]);
     }
-    md.push_str(&table.to_markdown());
+    md.push_str(&table.to_markdown()?);
 
     md.push_str("\n## Table 7.2 analogue: simulated 3-D urban drive (6-DOF)\n\n");
     md.push_str(
@@ -418,7 +418,7 @@ fn report_markdown(
             fmt_num(c.updates_per_s(), 1),
         ]);
     }
-    md.push_str(&table.to_markdown());
+    md.push_str(&table.to_markdown()?);
 
     md.push_str(
         "\n## Orderings beside the thesis (D = decay-rate, R = reflection, E = endpoint)\n\n\
@@ -482,7 +482,7 @@ fn report_markdown(
             ]);
         }
     }
-    md.push_str(&table.to_markdown());
+    md.push_str(&table.to_markdown()?);
     let decay_best = ours.iter().filter(|e| e[0] <= e[1] && e[0] <= e[2]).count();
     md.push_str(&format!(
         "\nDecay-rate has the lowest error on {decay_best} of {} of our data sets (thesis: 4 of 4). \
@@ -527,7 +527,7 @@ fn report_markdown(
             String::new(),
         ]);
     }
-    md.push_str(&table.to_markdown());
+    md.push_str(&table.to_markdown()?);
     md.push_str(
         "\nOne update = predict + weight (rayon over particles) + systematic resampling; measured in this run on the \
          shared 2-core machine.\n",
@@ -538,5 +538,5 @@ fn report_markdown(
     } else {
         md.push_str(&format!("\n## The ch. 8 corridor\n\n{corridor_markdown}"));
     }
-    md
+    Ok(md)
 }

@@ -597,7 +597,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          \"thesis rule\" fuses clamped cells (Khan 2017 §2.4); \"equal-value\" is our exact \
          extension (see below).\n"
     )?;
-    md.push_str(&real_table.to_markdown());
+    md.push_str(&real_table.to_markdown()?);
     writeln!(
         md,
         "\n## Summary of the earlier sets (beam-based, r = 0.2 m, M = 8; urban and geb079 are \
@@ -657,7 +657,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             "not in the thesis (our extension); aim ≥ 28.5 % / ≤ 1 / < 1".into(),
         ]);
     }
-    md.push_str(&summary.to_markdown());
+    md.push_str(&summary.to_markdown()?);
     writeln!(
         md,
         "\nThe equal-value rule is our extension beyond Khan 2017: cells whose log-odds are \
@@ -696,7 +696,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          points both sides know.\n",
         sets.first().map_or(0, |s| s.queries.len())
     )?;
-    md.push_str(&table.to_markdown());
+    md.push_str(&table.to_markdown()?);
     writeln!(
         md,
         "\n## Variants (beam-based, r = 0.2 m, M = 8)\n\nThe thesis fuses only clamped cells, \
@@ -704,7 +704,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          what the selection, the optional split-back (the thesis' future work) and our \
          equal-value rule (exact, with split-on-update) change.\n"
     )?;
-    md.push_str(&variants.to_markdown());
+    md.push_str(&variants.to_markdown()?);
     writeln!(
         md,
         "\n## Notes\n\n\

@@ -139,7 +139,7 @@ fn thesis_table(md: &mut String) -> Result<Value> {
          script and hand-made loop intervals). The camera data sets (Malaga 2009 parking 6L, \
          Oxford City Centre) are **not available here**, so our numbers above (other data, \
          other ground truth) cannot be set beside these: not comparable.\n\n{}",
-        t.to_markdown()
+        t.to_markdown()?
     )?;
     Ok(json!(
         TABLE_4_2

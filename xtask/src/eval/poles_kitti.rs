@@ -418,7 +418,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     writeln!(
         md,
         "## Localization beside Table 12.2 (same drive)\n\n{}",
-        table.to_markdown()
+        table.to_markdown()?
     )?;
     writeln!(
         md,
@@ -438,13 +438,13 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          stretch alone with the same filter, noise and 3 m / ±5° initial spread around the \
          ground truth at its first scan; errors every 1 m. The last column localizes the same \
          stretch on the same-drive map (same runs and seeds).\n\n{}",
-        later.to_markdown()
+        later.to_markdown()?
     )?;
     writeln!(
         md,
         "## Detection quality\n\nMap poles within 12 m of the driven scans against the \
          simulated poles there; a match is the closest unused pair within 1 m.\n\n{}",
-        detection.to_markdown()
+        detection.to_markdown()?
     )?;
     writeln!(
         md,
@@ -455,7 +455,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          same-drive runs. `total` = the whole sequence (world, scans, maps, all runs). \
          Measured on a shared 2-core machine while other jobs ran: absolute times are \
          pessimistic.\n\n{}",
-        speed.to_markdown()
+        speed.to_markdown()?
     )?;
     writeln!(md, "## Notes\n\n{}", NOTES)?;
     for note in &notes {

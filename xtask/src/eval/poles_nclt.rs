@@ -528,19 +528,19 @@ fn report(
          the session plan makes the reference map cover the first session's window and the \
          new quarters of the later ones.\n\n{}\n{}",
         super::sim::gap_note(ctx)?,
-        sessions_table(campus).to_markdown()
+        sessions_table(campus).to_markdown()?
     )?;
     writeln!(
         md,
         "## Semi-NCLT: localization beside Table 12.1\n\n{}",
-        semi.localization.to_markdown()
+        semi.localization.to_markdown()?
     )?;
     writeln!(
         md,
         "## Semi-NCLT: detection quality\n\nMap poles within 12 m of a session's drive \
          against the true poles of that session there (after its changes; match: closest \
          unused pair within 1 m).\n\n{}",
-        semi.detection.to_markdown()
+        semi.detection.to_markdown()?
     )?;
     writeln!(
         md,
@@ -553,7 +553,7 @@ fn report(
         semi.map_totals.trace_secs + semi.map_totals.score_secs,
         semi.map_totals.points_per_sec() / 1e6,
         semi_secs,
-        semi.speed.to_markdown()
+        semi.speed.to_markdown()?
     )?;
     match urban {
         Some(u) => {
@@ -564,8 +564,8 @@ fn report(
                  protocol ({} map poles; map extraction {:.2} M points/s).\n\n{}\n\n{}",
                 u.map_poles,
                 u.map_totals.points_per_sec() / 1e6,
-                u.localization.to_markdown(),
-                u.detection.to_markdown()
+                u.localization.to_markdown()?,
+                u.detection.to_markdown()?
             )?;
         }
         None => writeln!(

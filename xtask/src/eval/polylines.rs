@@ -303,7 +303,7 @@ fn metric_table(
     f: impl Fn(&Outcome) -> f64,
     scale: f64,
     decimals: usize,
-) -> String {
+) -> Result<String> {
     let mut headers = vec!["J".to_owned()];
     headers.extend(VARIANTS.iter().map(|v| v.label.to_owned()));
     let mut table = Table::new(headers);
@@ -484,9 +484,9 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         let _ = writeln!(
             md,
             "RMSE in mm:\n\n{}",
-            metric_table(results, |o| o.rmse_m, 1e3, 1)
+            metric_table(results, |o| o.rmse_m, 1e3, 1)?
         );
-        let _ = writeln!(md, "f:\n\n{}", metric_table(results, |o| o.f, 1.0, 3));
+        let _ = writeln!(md, "f:\n\n{}", metric_table(results, |o| o.f, 1.0, 3)?);
         write_figure(
             &fig_dir,
             "real-rmse.svg",
@@ -536,20 +536,20 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     let _ = writeln!(
         md,
         "RMSE in mm (σ_radial = 30 mm):\n\n{}",
-        metric_table(sr, |o| o.rmse_m, 1e3, 1)
+        metric_table(sr, |o| o.rmse_m, 1e3, 1)?
     );
-    let _ = writeln!(md, "f:\n\n{}", metric_table(sr, |o| o.f, 1.0, 3));
+    let _ = writeln!(md, "f:\n\n{}", metric_table(sr, |o| o.f, 1.0, 3)?);
     let _ = writeln!(
         md,
         "a with the ground-truth area as denominator (reference implementation):\n\n{}",
-        metric_table(sr, |o| o.a_gt, 1.0, 3)
+        metric_table(sr, |o| o.a_gt, 1.0, 3)?
     );
     let _ = writeln!(
         md,
         "a with the estimated area as denominator (as printed in the thesis):\n\n{}",
-        metric_table(sr, |o| o.a_printed, 1.0, 3)
+        metric_table(sr, |o| o.a_printed, 1.0, 3)?
     );
-    let _ = writeln!(md, "IoU:\n\n{}", metric_table(sr, |o| o.iou, 1.0, 3));
+    let _ = writeln!(md, "IoU:\n\n{}", metric_table(sr, |o| o.iou, 1.0, 3)?);
     write_figure(
         &fig_dir,
         "sim-rmse.svg",
@@ -637,7 +637,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         );
         t.row(row);
     }
-    let _ = writeln!(md, "{}", t.to_markdown());
+    let _ = writeln!(md, "{}", t.to_markdown()?);
     let _ = writeln!(
         md,
         "The thesis times are MATLAB on one Intel Xeon 2.50 GHz thread; ours are Rust on the \
@@ -687,7 +687,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             if mean <= aim { "yes" } else { "no" }.to_owned(),
         ]);
     }
-    let _ = writeln!(md, "{}", t.to_markdown());
+    let _ = writeln!(md, "{}", t.to_markdown()?);
 
     let _ = writeln!(md, "## PLE+ solver: Levenberg–Marquardt vs Nelder–Mead\n");
     let mut t = Table::new([
@@ -715,7 +715,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             ]);
         }
     }
-    let _ = writeln!(md, "{}", t.to_markdown());
+    let _ = writeln!(md, "{}", t.to_markdown()?);
 
     // Example pictures.
     let example_config = PolylineConfig::new(Method::PlePlus, 20);

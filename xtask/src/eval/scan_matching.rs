@@ -232,7 +232,7 @@ fn run_real(ctx: &EvalContext, md: &mut String) -> Result<Value> {
             pairs.len()
         );
     }
-    let _ = writeln!(md, "{}", table.to_markdown());
+    let _ = writeln!(md, "{}", table.to_markdown()?);
     let _ = writeln!(
         md,
         "Without odometry, the first bad relations on Intel fall on in-place turns of about \
@@ -344,7 +344,7 @@ fn run_generated(ctx: &EvalContext, md: &mut String, lut: &IntensityCorrection) 
         raw.len(),
         pairs.len()
     );
-    let _ = writeln!(md, "{}", table.to_markdown());
+    let _ = writeln!(md, "{}", table.to_markdown()?);
     Ok(Value::Array(out))
 }
 
@@ -470,7 +470,7 @@ fn run_calibration(ctx: &EvalContext, md: &mut String) -> Result<(Value, Intensi
         100.0 * inside as f64 / lut.values.len() as f64,
         fit_s
     );
-    let _ = writeln!(md, "{}", table.to_markdown());
+    let _ = writeln!(md, "{}", table.to_markdown()?);
     Ok((
         json!({ "models": out, "lut_fit_s": fit_s }),
         IntensityCorrection::Lut(lut),
@@ -614,7 +614,7 @@ fn run_failure_case(
          σ_r = 1 cm, no odometry (as Hector). ϱ̄ from the LUT above with PCA normals of the scan.\n",
         truth.len()
     );
-    let _ = writeln!(md, "{}", table.to_markdown());
+    let _ = writeln!(md, "{}", table.to_markdown()?);
     let _ = writeln!(
         md,
         "Maps (finest level, 5 cm) after the run: occupancy-only (left: the map smears where \
@@ -692,7 +692,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     for (log, sm, graph) in ANCHORS {
         anchors.row([log, sm, graph]);
     }
-    let _ = writeln!(md, "{}", anchors.to_markdown());
+    let _ = writeln!(md, "{}", anchors.to_markdown()?);
     let real = run_real(ctx, &mut md)?;
     let speeds: Vec<(String, f64)> = real
         .as_array()

@@ -108,7 +108,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             "**SegComp data is missing**: no `perc.test.N` range images under `{}`.\n\n{HOW_TO_GET}\n\n\
              ### Table 11.1 (thesis, SegComp rows)\n\n{}",
             dir.display(),
-            thesis.to_markdown()
+            thesis.to_markdown()?
         );
         eprintln!(
             "segcomp: data missing under {} — {HOW_TO_GET}",
@@ -221,8 +221,8 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         } else {
             ""
         },
-        table.to_markdown(),
-        thesis.to_markdown()
+        table.to_markdown()?,
+        thesis.to_markdown()?
     );
     Ok(EvalReport {
         name: NAME,

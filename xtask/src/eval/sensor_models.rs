@@ -243,8 +243,8 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     }
 
     let seconds = started.elapsed().as_secs_f64();
-    let mut markdown = report::markdown(&sets, &plan_text(&plan, ctx.quick), &notes);
-    markdown.push_str(&report::coarse_section(&coarse, COARSE_CELL_M));
+    let mut markdown = report::markdown(&sets, &plan_text(&plan, ctx.quick), &notes)?;
+    markdown.push_str(&report::coarse_section(&coarse, COARSE_CELL_M)?);
     let json = json!({
         "quick": ctx.quick,
         "seed": SEED,

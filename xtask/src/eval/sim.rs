@@ -113,7 +113,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     }
     bar.finish_and_clear();
     md.push_str("## The sets\n\n");
-    md.push_str(&table.to_markdown());
+    md.push_str(&table.to_markdown()?);
     md.push_str(
         "\nEvery data file is summarized by raypath-io as `raypath info` does; data files are everything but the ground-truth JSON \
          files (world descriptions, polygon vertices, corridor runs) and SemanticKITTI-style \
@@ -127,7 +127,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     }
 
     md.push_str("\n## Statistics beside the real data and the thesis\n\n");
-    md.push_str(&comparison_table(&sets, ctx)?.to_markdown());
+    md.push_str(&comparison_table(&sets, ctx)?.to_markdown()?);
 
     md.push_str("\n## Realism: real KITTI frames beside simulated frames at the same places\n\n");
     let realism = realism::run(ctx, &mut md)?;

@@ -253,11 +253,11 @@ fn referenced(ctx: &EvalContext, md: &mut String) -> Result<Vec<Value>> {
         bar.inc(1);
     }
     bar.finish_and_clear();
-    let _ = writeln!(md, "{}", table.to_markdown());
+    let _ = writeln!(md, "{}", table.to_markdown()?);
     Ok(rows)
 }
 
-fn published(md: &mut String, rows: &[Value]) {
+fn published(md: &mut String, rows: &[Value]) -> Result<()> {
     let mut t = Table::new([
         "log",
         "raypath-slam (ours)",
@@ -284,7 +284,8 @@ fn published(md: &mut String, rows: &[Value]) {
             "no: ours over consecutive corrected-log scans, theirs over the benchmark's relation files; other hardware",
         ]);
     }
-    let _ = writeln!(md, "{}", t.to_markdown());
+    let _ = writeln!(md, "{}", t.to_markdown()?);
+    Ok(())
 }
 
 fn unreferenced(ctx: &EvalContext, md: &mut String) -> Result<Vec<Value>> {
@@ -348,7 +349,7 @@ fn unreferenced(ctx: &EvalContext, md: &mut String) -> Result<Vec<Value>> {
             "seconds": seconds, "scans_per_second": sps, "map": png,
         }));
     }
-    let _ = writeln!(md, "{}", table.to_markdown());
+    let _ = writeln!(md, "{}", table.to_markdown()?);
     Ok(rows)
 }
 
@@ -429,7 +430,7 @@ fn residual_ablation(ctx: &EvalContext, md: &mut String) -> Result<Vec<Value>> {
             rows.push(v);
         }
     }
-    let _ = writeln!(md, "{}", table.to_markdown());
+    let _ = writeln!(md, "{}", table.to_markdown()?);
     Ok(rows)
 }
 
@@ -474,7 +475,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          them; graph mapping and GMapping from Kümmerle et al. (2009) as recalled — **not \
          re-checked** against the papers (not available offline).\n"
     );
-    published(&mut md, &rows);
+    published(&mut md, &rows)?;
     let _ = writeln!(
         md,
         "\n## Large loops without reference (real)\n\nNo corrected log: the maps are shown, with \

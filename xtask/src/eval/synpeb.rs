@@ -396,10 +396,10 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         } else {
             "all test scans"
         },
-        table = table.to_markdown(),
-        presets = presets.to_markdown(),
-        thesis = thesis.to_markdown(),
-        aims = aims.to_markdown(),
+        table = table.to_markdown()?,
+        presets = presets.to_markdown()?,
+        thesis = thesis.to_markdown()?,
+        aims = aims.to_markdown()?,
         speedup = 5760.0 / t2,
     );
     Ok(EvalReport {

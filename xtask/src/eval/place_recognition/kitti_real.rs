@@ -266,7 +266,7 @@ pub fn run(ctx: &EvalContext, vocabulary: Option<&Arc<BinaryVocabulary>>) -> Res
         frames.len(),
         truth.true_pairs()
     )?;
-    writeln!(md, "{}", table.to_markdown())?;
+    writeln!(md, "{}", table.to_markdown()?)?;
     if ctx.quick {
         writeln!(
             md,
@@ -329,7 +329,7 @@ pub fn run(ctx: &EvalContext, vocabulary: Option<&Arc<BinaryVocabulary>>) -> Res
          scans (`raypath-sim` semi-synthetic KITTI, world seed {DEFAULT_SEED}) at frames 0–9 of \
          the same sequence's `kitti-poles` trajectory (the KITTI poses, within about a metre of \
          the SemanticKITTI poses of the real frames). Statistics pooled over the 10 frames.\n\n{}",
-        stats.to_markdown()
+        stats.to_markdown()?
     )?;
     let summary = vec![format!(
         "Real 3-D ({} real frames of {}, kidnapped; counted over the {n} with another frame of \

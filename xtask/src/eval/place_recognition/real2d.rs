@@ -269,14 +269,14 @@ pub fn run(ctx: &EvalContext) -> Result<Section> {
          on a shared 2-core machine).\n",
         truth::rule_2d()
     )?;
-    writeln!(md, "{}", table.to_markdown())?;
+    writeln!(md, "{}", table.to_markdown()?)?;
     for row in aim_rows.iter().chain(&sym_aim_rows) {
         aims.row(row.clone());
     }
     writeln!(
         md,
         "**Aim: IBuILD recall at 100 % precision ≥ the DBoW2-style baseline**, per log:\n\n{}",
-        aims.to_markdown()
+        aims.to_markdown()?
     )?;
     writeln!(
         md,
@@ -287,7 +287,7 @@ pub fn run(ctx: &EvalContext) -> Result<Section> {
          above. δ = {} is the default used in the tables above (chosen before seeing these \
          numbers; picking the best δ afterwards would tune on the test data).\n\n{}",
         methods::DEFAULT_DELTA,
-        sweep.to_markdown()
+        sweep.to_markdown()?
     )?;
     writeln!(md, "{pictures}")?;
     for n in &notes {

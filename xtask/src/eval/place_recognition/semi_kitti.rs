@@ -436,8 +436,8 @@ pub fn run(ctx: &EvalContext, vocabulary: Option<&Arc<BinaryVocabulary>>) -> Res
             ""
         }
     )?;
-    writeln!(md, "{}", info.to_markdown())?;
-    writeln!(md, "{}", table.to_markdown())?;
+    writeln!(md, "{}", info.to_markdown()?)?;
+    writeln!(md, "{}", table.to_markdown()?)?;
     for row in &claim_rows {
         claims.row(row.clone());
     }
@@ -450,19 +450,19 @@ pub fn run(ctx: &EvalContext, vocabulary: Option<&Arc<BinaryVocabulary>>) -> Res
          §4.6.2, Fig. 4.22–4.28; kidnapped; each key point compared on its own). With thousands \
          of pairs and few true ones, precision at 100 % recall stays near the share of true \
          pairs for every method, so that key point separates little here:\n\n{}",
-        claims.to_markdown()
+        claims.to_markdown()?
     )?;
     writeln!(
         md,
         "**Aim: IBuILD on intensity images, recall at 100 % precision ≥ Scan Context**, per \
          sequence:\n\n{}",
-        aims.to_markdown()
+        aims.to_markdown()?
     )?;
     writeln!(
         md,
         "**IBuILD δ sweep on intensity images** (as in section 1; δ = {} above):\n\n{}",
         methods::DEFAULT_DELTA,
-        sweep.to_markdown()
+        sweep.to_markdown()?
     )?;
     writeln!(md, "{pictures}")?;
     for s in &missing {

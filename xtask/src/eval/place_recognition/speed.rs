@@ -344,13 +344,13 @@ pub fn run(ctx: &EvalContext) -> Result<Section> {
          the 40 real KITTI clouds, each moved by a deterministic ±3 m / any-yaw jitter and \
          thinned to every other point (same description cost, distinct ring keys).\n"
     )?;
-    writeln!(md, "{}", table.to_markdown())?;
+    writeln!(md, "{}", table.to_markdown()?)?;
     writeln!(
         md,
         "Stage breakdown per frame at {biggest} frames (IBuILD; keypoint detection and \
          description are one stage here; assignment includes the search of every visual word \
          of the frame):\n\n{}",
-        stages.to_markdown()
+        stages.to_markdown()?
     )?;
     let summary = ibuild
         .iter()

@@ -227,7 +227,7 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
         lut.angles,
         100.0 * inside as f64 / lut.values.len().max(1) as f64,
     );
-    let _ = writeln!(md, "All held-back points:\n\n{}", tables[0].to_markdown());
+    let _ = writeln!(md, "All held-back points:\n\n{}", tables[0].to_markdown()?);
     let _ = writeln!(
         md,
         "Only the held-back points inside the LUT's calibrated domain (the road samples' hull \
@@ -239,7 +239,7 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
             .map(|(c, v)| format!("{} {:.1} %", c.1, 100.0 * v))
             .collect::<Vec<_>>()
             .join(", "),
-        tables[1].to_markdown()
+        tables[1].to_markdown()?
     );
     let cv_of = |rows: &[Value], model: &str| -> Vec<f64> {
         rows.iter()

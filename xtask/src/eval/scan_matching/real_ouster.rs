@@ -246,7 +246,7 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
          calibration is for; its rank correlation with the sensor's reflectivity shows how \
          close the LUT comes to the vendor's calibration). Ground of one kind is assumed; \
          asphalt, paint and grass in one scene add spread no (r, α) model removes.\n\n{}",
-        table.to_markdown()
+        table.to_markdown()?
     );
     for note in &notes {
         let _ = writeln!(md, "* {note}");

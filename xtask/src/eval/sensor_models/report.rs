@@ -1,6 +1,7 @@
 //! The markdown and JSON of the evaluation: Tables 7.3 (a, b), 8.2 / 8.3 ratios, speed and
 //! the agreement with the thesis, computed from the figures.
 
+use anyhow::Result;
 use raypath_sensor_models::scoring::{ScoreReport, ScoreRow};
 use serde_json::json;
 
@@ -186,7 +187,7 @@ fn model_table(sets: &[DataSet], f: fn(&ScoreRow) -> f64, format: fn(f64) -> Str
 }
 
 /// The report body.
-pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> String {
+pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> Result<String> {
     let mut md = String::new();
     md.push_str(
         "Every sensor model of `raypath-sensor-models` scored as in Schaefer (2020) Sec. 7.6.2 \
@@ -218,16 +219,16 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> String {
     }
 
     md.push_str("### (a) D'(g‖h), summed over all scored rays (lower is better)\n\n");
-    md.push_str(&model_table(sets, |r| r.neg_log_likelihood, sci).to_markdown());
+    md.push_str(&model_table(sets, |r| r.neg_log_likelihood, sci).to_markdown()?);
     md.push_str("\nThesis Table 7.3(a), 3-D VIONA data:\n\n");
     let mut thesis = Table::new(["data set", "DEC", "REF", "END"]);
     for (name, d, _) in THESIS_73 {
         thesis.row([name.to_owned(), sci(d[0]), sci(d[1]), sci(d[2])]);
     }
-    md.push_str(&thesis.to_markdown());
+    md.push_str(&thesis.to_markdown()?);
 
     md.push_str("\n### (b) Inverse KL D(h‖g), averaged over test scans (lower is better)\n\n");
-    md.push_str(&model_table(sets, |r| r.inverse_kl, |v| fmt_num(v, 2)).to_markdown());
+    md.push_str(&model_table(sets, |r| r.inverse_kl, |v| fmt_num(v, 2)).to_markdown()?);
     md.push_str("\nThesis Table 7.3(b):\n\n");
     let mut thesis = Table::new(["data set", "DEC", "REF", "END"]);
     for (name, _, k) in THESIS_73 {
@@ -238,7 +239,7 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> String {
             fmt_num(k[2], 2),
         ]);
     }
-    md.push_str(&thesis.to_markdown());
+    md.push_str(&thesis.to_markdown()?);
     md.push_str(
         "\nWith σ = 0.05 m and 50 samples in a 19.6 m² disc the nearest sample lies typically \
          0.2–0.4 m from the truth, so `ĝ` is practically one-hot on it, and every bit of model \
@@ -272,7 +273,7 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> String {
             fmt_num(kl_ratio(r, "decay-rate"), 3),
         ]);
     }
-    md.push_str(&ratios.to_markdown());
+    md.push_str(&ratios.to_markdown()?);
     md.push_str(
         "\n*D' ratio* = D'(ML) / D'(FMP), the thesis's ratio of the two negative log-likelihood \
          sums (> 1: the posterior is better); it is shown only when both sums are positive — \
@@ -297,9 +298,9 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> String {
             fmt_num(k[1], 2),
         ]);
     }
-    md.push_str(&thesis.to_markdown());
+    md.push_str(&thesis.to_markdown()?);
     md.push_str("\nKL to truth per model (summed over test scans, nats):\n\n");
-    md.push_str(&model_table(sets, |r| r.kl_ground_truth, |v| fmt_num(v, 1)).to_markdown());
+    md.push_str(&model_table(sets, |r| r.kl_ground_truth, |v| fmt_num(v, 1)).to_markdown()?);
 
     md.push_str("\n### (d) Speed in this run\n\n");
     let mut headers = vec![
@@ -328,7 +329,7 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> String {
         }));
         speed.row(cells);
     }
-    md.push_str(&speed.to_markdown());
+    md.push_str(&speed.to_markdown()?);
     md.push_str(
         "\nMap building: statistics only (H, M, R per cell with the exact traversal), wall-clock \
          on all cores. Evaluations: ray log-likelihoods (exact traversal per ray, no \
@@ -366,7 +367,7 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> String {
             },
         ]);
     }
-    md.push_str(&agreement.to_markdown());
+    md.push_str(&agreement.to_markdown()?);
     let total = sets.len();
     let holds = |counts: &[(usize, usize); 3]| counts.iter().map(|c| c.0).sum::<usize>();
     let group = |keep: &dyn Fn(usize) -> bool| -> String {
@@ -411,14 +412,14 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> String {
          voxels — so an ordering that fails here is a statement about these data, not a \
          refutation; the *fails on* column names the data sets.\n",
     );
-    md
+    Ok(md)
 }
 
 /// Section (e): the real 2-D logs scored again at the thesis's cell size, with the
 /// agreement tally of those rows.
-pub fn coarse_section(sets: &[DataSet], cell_m: f64) -> String {
+pub fn coarse_section(sets: &[DataSet], cell_m: f64) -> Result<String> {
     if sets.is_empty() {
-        return String::new();
+        return Ok(String::new());
     }
     let mut md = format!(
         "\n### (e) The real 2-D logs at {cell_m} m cells (the thesis's voxel edge)\n\n\
@@ -426,9 +427,9 @@ pub fn coarse_section(sets: &[DataSet], cell_m: f64) -> String {
          cell edge. Coarser cells make the ray-casting models' likelihoods smoother in the pose, \
          which is the regime of the thesis's 0.5 m voxels.\n\nD'(g‖h):\n\n"
     );
-    md.push_str(&model_table(sets, |r| r.neg_log_likelihood, sci).to_markdown());
+    md.push_str(&model_table(sets, |r| r.neg_log_likelihood, sci).to_markdown()?);
     md.push_str("\nInverse KL D(h‖g):\n\n");
-    md.push_str(&model_table(sets, |r| r.inverse_kl, |v| fmt_num(v, 2)).to_markdown());
+    md.push_str(&model_table(sets, |r| r.inverse_kl, |v| fmt_num(v, 2)).to_markdown()?);
     md.push_str(&format!(
         "\nAgreement with the thesis's orderings at {cell_m} m:\n\n"
     ));
@@ -444,6 +445,6 @@ pub fn coarse_section(sets: &[DataSet], cell_m: f64) -> String {
             },
         ]);
     }
-    md.push_str(&agreement.to_markdown());
-    md
+    md.push_str(&agreement.to_markdown()?);
+    Ok(md)
 }

@@ -263,12 +263,12 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
         frames - 1,
         beams_hint(&rows),
     );
-    md.push_str(&table.to_markdown());
+    md.push_str(&table.to_markdown()?);
     let _ = writeln!(
         md,
         "\nHow far the simulation is from the real frames (1 = identical distributions):\n"
     );
-    md.push_str(&gaps.to_markdown());
+    md.push_str(&gaps.to_markdown()?);
     md.push('\n');
     Ok(json!({ "sequences": rows }))
 }

@@ -141,13 +141,13 @@ pub(super) fn markdown(
     writeln!(
         md,
         "### Real versus simulated, all sequences pooled\n\n{}",
-        pooled_table.to_markdown()
+        pooled_table.to_markdown()?
     )?;
     writeln!(md, "{CHANGE}")?;
     writeln!(
         md,
         "### Per sequence, ten-scan local map\n\n{}",
-        per_sequence.to_markdown()
+        per_sequence.to_markdown()?
     )?;
     writeln!(
         md,
@@ -157,19 +157,19 @@ pub(super) fn markdown(
          sequence, in the frame of the KITTI ground truth) matched to a reference clustered \
          here; the last column scores the one-pose simulation against the poles placed in \
          its world (kinds: trunk = trunk, others = pole).\n\n{}",
-        references.to_markdown()
+        references.to_markdown()?
     )?;
     writeln!(
         md,
         "### Missed real references (ten-scan local map)\n\nNearest scan range, labelled \
          shaft points in the band, their vertical span, sign-plate points, nearest \
          detection, and the labelled classes of all points within 0.3 m of the centre.\n\n{}",
-        misses.to_markdown()
+        misses.to_markdown()?
     )?;
     writeln!(
         md,
         "### Real detections matched to no reference (ten-scan local map)\n\n{}",
-        false_positives.to_markdown()
+        false_positives.to_markdown()?
     )?;
     for note in notes {
         writeln!(md, "* {note}")?;

@@ -89,7 +89,7 @@ pub fn tuning(ctx: &EvalContext, frames: &[Frame], chosen: &[Method]) -> Result<
         "{}
 Rank of the parameters used in their grid: {}.
 ",
-        table.to_markdown(),
+        table.to_markdown()?,
         notes.join("; ")
     );
     Ok((markdown, json!(out)))

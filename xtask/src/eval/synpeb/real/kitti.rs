@@ -154,9 +154,9 @@ pub fn run(ctx: &EvalContext) -> Result<(String, Value, Vec<Frame>)> {
          the rest share a pixel with a nearer return of the same laser).\n\n\
          Where the plane pixels lie, by SemanticKITTI class, on {which} (classes with at least \
          1 % under some method):\n\n{}",
-        table.to_markdown(),
+        table.to_markdown()?,
         100.0 * kept as f64 / source.max(1) as f64,
-        classes.to_markdown(),
+        classes.to_markdown()?,
     );
     results.insert(
         "projection".into(),

@@ -61,5 +61,5 @@ pub fn run(ctx: &EvalContext) -> Result<(String, Value)> {
             results.insert(format!("{}_{tag}", key(&method)), p.json());
         }
     }
-    Ok((table.to_markdown(), Value::Object(results)))
+    Ok((table.to_markdown()?, Value::Object(results)))
 }
