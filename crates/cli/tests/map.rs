@@ -307,9 +307,16 @@ fn bad_inputs_exit_2_naming_file_and_place() {
     let cut = dir.path().join("cut.log");
     std::fs::write(&cut, &whole[..whole.len() - 30]).expect("write");
     let out = run(&cut, &["--json"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("cut.log: line 5") && err.contains("mid-line"), "{err}");
+    assert!(
+        err.contains("cut.log: line 5") && err.contains("mid-line"),
+        "{err}"
+    );
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     assert_eq!(doc["rays"], (SCANS - 1) * BEAMS, "{doc}");
     let out = run(&cut, &["--strict"]);
