@@ -128,21 +128,12 @@ fn json_contract_tum_and_map_on_a_synthetic_log() {
 
 #[test]
 fn intel_against_its_corrected_log() {
-    let data = std::env::var("RAYPATH_DATA").unwrap_or_else(|_| "datasets".into());
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let base = root.join(&data);
-    let (raw, corrected) = (
-        base.join("carmen/raw/intel.clf.bz2"),
-        base.join("carmen/corrected/intel-corrected.log.gz"),
-    );
-    if !raw.exists() || !corrected.exists() {
-        eprintln!(
-            "skipping: {} or {} not found",
-            raw.display(),
-            corrected.display()
-        );
+    let (Some(raw), Some(corrected)) = (
+        raypath_io::data::require("carmen/raw/intel.clf.bz2"),
+        raypath_io::data::require("carmen/corrected/intel-corrected.log.gz"),
+    ) else {
         return;
-    }
+    };
     let out = raypath(&[
         "scan-match",
         raw.to_str().unwrap(),

@@ -48,12 +48,32 @@ pub fn require(relative: impl AsRef<Path>) -> Option<PathBuf> {
         );
     }
     if found.is_none() {
-        eprintln!(
-            "skipping: {} not found (set RAYPATH_DATA to the data directory)",
+        skip(format_args!(
+            "{} not found (set RAYPATH_DATA to the data directory)",
             data_dir().join(relative).display()
-        );
+        ));
     }
     found
+}
+
+/// Reports a test (or part of one) that cannot run here: prints `skipping: {reason}` and,
+/// when the environment variable `RAYPATH_SKIP_LOG` names a file, appends the reason to it
+/// as one line, so a run can count what it skipped (CI prints the count and the reasons).
+/// [`require`] and [`require_python`] report through it; tests that need an external
+/// program call it directly.
+pub fn skip(reason: impl std::fmt::Display) {
+    eprintln!("skipping: {reason}");
+    if let Some(log) = std::env::var_os("RAYPATH_SKIP_LOG").filter(|v| !v.is_empty()) {
+        use std::io::Write;
+        let appended = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&log)
+            .and_then(|mut file| writeln!(file, "{reason}"));
+        if let Err(e) = appended {
+            eprintln!("warning: cannot append to RAYPATH_SKIP_LOG: {e}");
+        }
+    }
 }
 
 /// For tests that check our files with Python tools: true when `python3` imports every module
@@ -81,6 +101,6 @@ pub fn require_python_in(python: &str, imports: &str) -> bool {
     if std::env::var("RAYPATH_REQUIRE_PYTHON").is_ok_and(|v| v == "1") {
         panic!("RAYPATH_REQUIRE_PYTHON=1 but {reason}");
     }
-    eprintln!("skipping: {reason}");
+    skip(reason);
     false
 }

@@ -97,7 +97,7 @@ fn octomap_bt2vrml_reads_our_bt_files() {
     let run = match Command::new("bt2vrml").arg(&path).output() {
         Ok(out) => out,
         Err(e) => {
-            eprintln!("skipping: bt2vrml (octomap-tools) not runnable: {e}");
+            raypath_io::data::skip(format_args!("bt2vrml (octomap-tools) not runnable: {e}"));
             return;
         }
     };

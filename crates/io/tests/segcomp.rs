@@ -91,7 +91,7 @@ fn lzw_matches_compress_program_when_installed() {
     use std::io::Write;
     use std::process::{Command, Stdio};
     if Command::new("compress").arg("-V").output().is_err() {
-        eprintln!("skipping: no `compress` program (apt-get install ncompress) to compare with");
+        raypath_io::data::skip("no `compress` program (apt-get install ncompress) to compare with");
         return;
     }
     for (k, bits) in (9..=16).enumerate() {

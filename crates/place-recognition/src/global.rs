@@ -266,14 +266,10 @@ mod real_data {
     /// A KITTI velodyne scan (`float32 x y z intensity`), or `None` when `RAYPATH_DATA` does
     /// not hold it.
     fn kitti(sequence: &str, frame: usize) -> Option<PointCloud> {
-        let dir = std::env::var_os("RAYPATH_DATA").filter(|d| !d.is_empty())?;
-        let path = std::path::Path::new(&dir).join(format!(
+        let path = raypath_io::data::require(format!(
             "kitti/sequences/{sequence}/velodyne/{frame:06}.bin"
-        ));
-        let Ok(bytes) = std::fs::read(&path) else {
-            eprintln!("skipping: {} not found", path.display());
-            return None;
-        };
+        ))?;
+        let bytes = std::fs::read(&path).unwrap();
         let values: Vec<f32> = bytes
             .chunks_exact(4)
             .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))

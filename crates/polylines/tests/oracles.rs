@@ -3,7 +3,6 @@
 //! for large J, PLE+ never worse than PLE.
 
 use std::f64::consts::{PI, TAU};
-use std::path::PathBuf;
 
 use nalgebra::Point2;
 use raypath_geometry::Scan2;
@@ -145,13 +144,11 @@ fn variance_does_not_change_the_result() {
 
 /// Up to `per_log` evenly spaced scans of every corrected log under RAYPATH_DATA.
 fn real_scans(per_log: usize) -> Vec<Scan2> {
-    let dir = std::env::var_os("RAYPATH_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../datasets"))
-        .join("carmen/corrected");
-    let Ok(entries) = std::fs::read_dir(&dir) else {
-        eprintln!("skipping real scans: {} not found", dir.display());
+    let Some(dir) = raypath_io::data::require("carmen/corrected") else {
         return Vec::new();
+    };
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        panic!("{} is not a readable directory", dir.display());
     };
     let mut paths: Vec<_> = entries
         .flatten()

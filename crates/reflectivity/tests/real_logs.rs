@@ -2,9 +2,8 @@
 //! one, and Hector with the odometry guess beats the odometry on the relative-motion error.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // test code: a panic is the failure report
 
-use std::path::PathBuf;
-
 use raypath_geometry::Pose2;
+use raypath_io::data::require;
 use raypath_io::sequence::{LaserChoice, PlanarOptions, pair_reference, read_planar};
 use raypath_reflectivity::MatcherConfig;
 use raypath_reflectivity::PointFilter;
@@ -12,28 +11,14 @@ use raypath_reflectivity::benchmark::{
     consecutive_relations, pair_by_ranges, read_laser_log, relative_errors, run_matcher,
 };
 
-fn data(relative: &str) -> PathBuf {
-    let root = std::env::var("RAYPATH_DATA").unwrap_or_else(|_| "datasets".into());
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .join(root)
-        .join(relative)
-}
-
 #[test]
 fn intel_pairs_and_scan_matching_beats_odometry() {
-    let (raw, corrected) = (
-        data("carmen/raw/intel.clf.bz2"),
-        data("carmen/corrected/intel-corrected.log.gz"),
-    );
-    if !raw.exists() || !corrected.exists() {
-        eprintln!(
-            "skipping: {} or {} not found",
-            raw.display(),
-            corrected.display()
-        );
+    let (Some(raw), Some(corrected)) = (
+        require("carmen/raw/intel.clf.bz2"),
+        require("carmen/corrected/intel-corrected.log.gz"),
+    ) else {
         return;
-    }
+    };
     let options = PlanarOptions {
         laser: LaserChoice::Front,
         ..PlanarOptions::default()

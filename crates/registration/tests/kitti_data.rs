@@ -21,11 +21,9 @@ fn real_kitti_frames_register_to_their_poses() {
     };
     let mut checked = 0;
     for seq in ["00", "01", "04", "07"] {
-        let dir = root.join(seq);
-        if !dir.exists() {
-            eprintln!("skipping sequence {seq}: {} not found", dir.display());
+        let Some(dir) = require(root.join(seq)) else {
             continue;
-        }
+        };
         // `SweepSequence` turns the camera poses into velodyne poses through `Tr`.
         let sequence = SweepSequence::open(&dir, &SweepOptions::default()).unwrap();
         let truth = sequence.reference.clone().unwrap();

@@ -205,12 +205,11 @@ fn radial_noise_of_a_level_has_its_sigma() {
 
 #[test]
 fn real_sample_statistics_when_installed() {
-    let Some(result) = synpeb::real_sample_stats() else {
-        eprintln!(
-            "skipping: {} not found (set RAYPATH_DATA)",
-            synpeb::REAL_SAMPLE
-        );
+    if raypath_io::data::require(synpeb::REAL_SAMPLE).is_none() {
         return;
+    }
+    let Some(result) = synpeb::real_sample_stats() else {
+        panic!("{} present but not readable", synpeb::REAL_SAMPLE);
     };
     let stats = result.unwrap();
     assert_eq!(stats.pixels, 10_000);
