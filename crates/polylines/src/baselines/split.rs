@@ -7,13 +7,20 @@
 //!   segment from the first to the last endpoint; repeatedly split the segment with the
 //!   endpoint farthest from it at that endpoint, until `J_max` vertices or no endpoint is
 //!   farther than `split_threshold_m` (reference implementation: 0.01 m). Vertices are
-//!   endpoints.
-//! * **SAM** (split-and-merge, Pavlidis & Horowitz 1974): the same splitting, but every
-//!   iteration first fits a total-least-squares line to the endpoints of each piece and
-//!   splits the piece with the largest endpoint-to-line distance; afterwards neighbouring
-//!   pieces whose joint fit stays within the threshold are merged. Vertices are the
-//!   intersections of neighbouring fitted lines (the ends: the first and last endpoint
-//!   projected onto their lines).
+//!   endpoints, so the result is one connected polyline.
+//! * **SAM** (split-and-merge, Pavlidis & Horowitz 1974), as Schaefer (2020, §10.5) runs it:
+//!   every piece of the endpoint sequence carries its own least-squares segment (the
+//!   total-least-squares line through its endpoints, cut at the projections of its first and
+//!   last endpoint). Split the piece whose endpoint lies farthest from its segment at that
+//!   endpoint and refit both halves, while some endpoint is farther than
+//!   `split_threshold_m` or the segments have fewer than `J_max` vertices; then merge the
+//!   two neighbouring pieces whose shared endpoint lies closest to the joined segment, and
+//!   refit, until at most `J_max` vertices remain. Fitted neighbours do not share their
+//!   end vertices, so the result is a set of separate segments (each two vertices): a depth
+//!   jump between two pieces stays open, and the rays there hit nothing — the thesis' "SAM
+//!   misses many rays". (An earlier version of this module joined neighbouring fitted lines
+//!   at their intersections into one polyline; the corners of lines fitted to distant pieces
+//!   then lay far in free space and the RMSE of rays hitting those bridges was metres.)
 
 use nalgebra::{Point2, Vector2};
 
@@ -99,90 +106,117 @@ impl Line {
         }
     }
 
-    fn distance(&self, p: &Point2<f64>) -> f64 {
-        (p - self.centroid).perp(&self.dir).abs()
-    }
-
     fn project(&self, p: &Point2<f64>) -> Point2<f64> {
         self.centroid + self.dir * (p - self.centroid).dot(&self.dir)
     }
-
-    fn max_distance(pts: &[Point2<f64>]) -> f64 {
-        let line = Line::fit(pts);
-        pts.iter().map(|p| line.distance(p)).fold(0.0, f64::max)
-    }
 }
 
-/// Runs SAM.
+/// Runs SAM (see the module docs).
 pub fn sam(rays: &ScanRays, config: &PolylineConfig) -> Polylines {
     let (pts, beams) = returned_points(rays);
     if pts.len() < 2 {
         return Polylines::default();
     }
-    // Pieces are index ranges [breaks[i], breaks[i + 1]] sharing their break points.
-    let mut breaks = vec![0, pts.len() - 1];
-    while breaks.len() < config.max_vertices {
-        let best = breaks
-            .windows(2)
-            .filter_map(|w| {
-                let (i, j) = (w[0], w[1]);
-                let line = Line::fit(&pts[i..=j]);
-                farthest(i, j, |m| line.distance(&pts[m]))
+    let mut pieces = vec![Piece::fit(&pts, 0, pts.len() - 1)];
+    // Split: the endpoint farthest from its piece's segment, while any is beyond the
+    // threshold or vertices are missing.
+    loop {
+        let worst = pieces
+            .iter()
+            .enumerate()
+            .filter_map(|(k, piece)| {
+                farthest(piece.first, piece.last, |m| piece.distance(&pts[m]))
+                    .map(|(m, d)| (k, m, d))
             })
-            .max_by(|a, b| a.1.total_cmp(&b.1));
-        let Some((m, d)) = best else { break };
-        if d < config.split_threshold_m {
+            .max_by(|a, b| a.2.total_cmp(&b.2));
+        let Some((k, m, d)) = worst else { break };
+        if d < config.split_threshold_m && vertex_count(&pieces) >= config.max_vertices {
             break;
         }
-        let at = breaks.partition_point(|&b| b < m);
-        breaks.insert(at, m);
+        let (first, last) = (pieces[k].first, pieces[k].last);
+        pieces[k] = Piece::fit(&pts, first, m);
+        pieces.insert(k + 1, Piece::fit(&pts, m, last));
     }
-    // Merge neighbouring pieces whose joint fit is within the threshold.
-    let mut i = 1;
-    while i + 1 < breaks.len() {
-        let (a, b) = (breaks[i - 1], breaks[i + 1]);
-        if Line::max_distance(&pts[a..=b]) < config.split_threshold_m {
-            breaks.remove(i);
+    // Merge: the shared endpoint closest to the segment joining its two pieces.
+    while vertex_count(&pieces) > config.max_vertices && pieces.len() > 1 {
+        let Some((k, _)) = pieces
+            .windows(2)
+            .enumerate()
+            .map(|(k, w)| {
+                let shared = &pts[w[0].last];
+                (k, point_segment_distance(shared, &w[0].start, &w[1].end))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+        else {
+            break;
+        };
+        let (first, last) = (pieces[k].first, pieces[k + 1].last);
+        pieces[k] = Piece::fit(&pts, first, last);
+        pieces.remove(k + 1);
+    }
+    polylines_of(&pieces, &beams)
+}
+
+/// A run `first..=last` of returned endpoints and its fitted segment `start → end`.
+#[derive(Clone, Copy, Debug)]
+struct Piece {
+    first: usize,
+    last: usize,
+    start: Point2<f64>,
+    end: Point2<f64>,
+}
+
+impl Piece {
+    /// The total-least-squares segment of `pts[first..=last]`, cut at the projections of the
+    /// first and last endpoint; two endpoints are their own segment.
+    fn fit(pts: &[Point2<f64>], first: usize, last: usize) -> Piece {
+        let (start, end) = if last - first < 2 {
+            (pts[first], pts[last])
         } else {
-            i += 1;
+            let line = Line::fit(&pts[first..=last]);
+            (line.project(&pts[first]), line.project(&pts[last]))
+        };
+        Piece {
+            first,
+            last,
+            start,
+            end,
         }
     }
-    let lines: Vec<Line> = breaks
-        .windows(2)
-        .map(|w| Line::fit(&pts[w[0]..=w[1]]))
-        .collect();
-    let mut vertices = Vec::with_capacity(breaks.len());
-    let mut rays_of = Vec::with_capacity(breaks.len());
-    for (v, &b) in breaks.iter().enumerate() {
-        let point = if v == 0 {
-            lines[0].project(&pts[b])
-        } else if v + 1 == breaks.len() {
-            lines[v - 1].project(&pts[b])
-        } else {
-            corner(&lines[v - 1], &lines[v], &pts[b])
-        };
-        vertices.push(point);
-        rays_of.push(beams[b]);
-    }
-    Polylines {
-        lines: vec![Polyline {
-            vertices,
-            rays: rays_of,
-            closed: false,
-        }],
+
+    fn distance(&self, p: &Point2<f64>) -> f64 {
+        point_segment_distance(p, &self.start, &self.end)
     }
 }
 
-/// The vertex between two fitted lines: their intersection, or (nearly parallel lines, or
-/// an intersection more than 1 m from the break point) the mean of the break point's
-/// projections onto both.
-fn corner(a: &Line, b: &Line, at: &Point2<f64>) -> Point2<f64> {
-    let fallback = Point2::from((a.project(at).coords + b.project(at).coords) * 0.5);
-    let denom = a.dir.perp(&b.dir);
-    if denom.abs() < 1e-6 {
-        return fallback;
+/// Vertices of the pieces joined where a segment ends exactly where the next starts (only
+/// unfitted two-point pieces do), as the reference implementation counts them.
+fn vertex_count(pieces: &[Piece]) -> usize {
+    let joined = pieces
+        .windows(2)
+        .filter(|w| (w[0].end - w[1].start).norm() <= 1e-10)
+        .count();
+    2 * pieces.len() - joined
+}
+
+/// The pieces as polylines: neighbours that share an end vertex form one polyline.
+fn polylines_of(pieces: &[Piece], beams: &[usize]) -> Polylines {
+    let mut lines: Vec<Polyline> = Vec::new();
+    let mut previous: Option<&Piece> = None;
+    for piece in pieces {
+        let joins = previous.is_some_and(|p| (p.end - piece.start).norm() <= 1e-10);
+        match lines.last_mut() {
+            Some(line) if joins => {
+                line.vertices.push(piece.end);
+                line.rays.push(beams[piece.last]);
+            }
+            _ => lines.push(Polyline {
+                vertices: vec![piece.start, piece.end],
+                rays: vec![beams[piece.first], beams[piece.last]],
+                closed: false,
+            }),
+        }
+        previous = Some(piece);
     }
-    let t = (b.centroid - a.centroid).perp(&b.dir) / denom;
-    let x = a.centroid + a.dir * t;
-    if (x - at).norm() > 1.0 { fallback } else { x }
+    Polylines { lines }
 }
