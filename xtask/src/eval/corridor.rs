@@ -36,7 +36,7 @@ use raypath_sim::corridor::{
 use raypath_sim::rng::stream;
 use serde_json::json;
 
-use super::EvalContext;
+use super::{EvalContext, comparable};
 use crate::table::{Table, fmt_num};
 
 /// Numbers of mapping visits per voxel (thesis Fig. 8.2).
@@ -330,6 +330,21 @@ fn thesis_significant(model: CorridorModel, n: u32) -> bool {
     }
 }
 
+/// The "comparable" cell of a corridor row: the thesis' significance (Sec. 8.5.1) beside
+/// ours from `runs` runs per n.
+fn comparable_cell(runs: usize) -> String {
+    if runs == RUNS_FULL {
+        comparable::yes(
+            "simulated in both: same corridor, map draws, n and 10 000 runs, same test; the \
+             MLM zero clamp and the conjugate prior's moment estimate are ours (thesis unstated)",
+        )
+    } else {
+        comparable::no(&format!(
+            "quick run: {runs} runs per n (thesis 10 000), so p-values are weaker"
+        ))
+    }
+}
+
 /// The corridor section of the `mcl` report: markdown and JSON.
 pub fn section(ctx: &EvalContext) -> Result<(String, serde_json::Value)> {
     let runs = if ctx.quick { RUNS_QUICK } else { RUNS_FULL };
@@ -399,6 +414,7 @@ pub fn section(ctx: &EvalContext) -> Result<(String, serde_json::Value)> {
             "ρ MLM-clamped".to_owned(),
             "wins / p vs clamped".to_owned(),
             format!("mean {prior_name} α, β"),
+            comparable::HEADER.to_owned(),
         ]);
         let mut agree = 0;
         for c in &cells {
@@ -420,6 +436,7 @@ pub fn section(ctx: &EvalContext) -> Result<(String, serde_json::Value)> {
                 fmt_num(c.mean_rho[3], 4),
                 format!("{} / {}", fmt_num(c.win_vs[2], 3), fmt_p(c.p_vs[2])),
                 format!("{:.2}, {:.2}", c.mean_prior[0], c.mean_prior[1]),
+                comparable_cell(runs),
             ]);
         }
         markdown.push_str(&format!(
@@ -513,6 +530,16 @@ mod tests {
         let r = rho(&flat, &obs, &mut Vec::new());
         let expected = (0..100).map(|t| 1.0 / (100 - t) as f64).sum::<f64>() / 100.0;
         assert!((r - expected).abs() < 1e-12);
+    }
+
+    #[test]
+    fn comparable_cell_names_the_run_count() {
+        assert!(comparable_cell(RUNS_FULL).starts_with("yes — simulated in both"));
+        let quick = comparable_cell(RUNS_QUICK);
+        assert!(
+            quick.starts_with("no — quick run: 500 runs per n"),
+            "{quick}"
+        );
     }
 
     #[test]

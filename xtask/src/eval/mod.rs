@@ -5,6 +5,7 @@
 //! data directory) and `target/eval/<name>.json`.
 
 mod carmen_angles;
+mod comparable;
 mod corridor;
 mod dct;
 mod geometry;

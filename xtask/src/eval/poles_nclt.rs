@@ -39,7 +39,7 @@ use raypath_sim::semi_nclt::{SemiNclt, SemiNcltConfig};
 use serde_json::json;
 
 use super::poles_kitti::{RunSummary, near, speed_row, truth_near};
-use super::{EvalContext, EvalReport};
+use super::{EvalContext, EvalReport, comparable};
 use crate::table::{Table, fmt_num};
 
 const NAME: &str = "poles-nclt";
@@ -76,7 +76,9 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         config.scans_per_session = FULL_SCANS;
     }
     let campus = SemiNclt::new(config, SEMI_SEED)?;
-    let semi = evaluate(ctx, campus.len(), runs, 7000, &|k| semi_session(&campus, k))?;
+    let semi = evaluate(ctx, campus.len(), runs, 7000, SEMI_DATA, &|k| {
+        semi_session(&campus, k)
+    })?;
     let semi_secs = started.elapsed().as_secs_f64();
     let figure = if ctx.quick {
         None
@@ -114,7 +116,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
                 truth,
             })
         };
-        Some(evaluate(ctx, dirs.len(), runs, 8000, &open)?)
+        Some(evaluate(ctx, dirs.len(), runs, 8000, URBAN_DATA, &open)?)
     };
     let total_secs = started.elapsed().as_secs_f64();
     let mut md = report(
@@ -211,12 +213,38 @@ struct Outcome {
     drives: Vec<(String, Vec<Point2<f64>>)>,
 }
 
-/// The protocol on `n` sessions opened (twice each: mapping, then localization) by `open`.
+/// What our semi-NCLT rows are, for the "comparable" column.
+const SEMI_DATA: &str = "semi-synthetic: simulated HDL-32E scans, scenery and changes along a \
+     window of the real NCLT path among its real poles";
+/// What our urban-nclt rows are, for the "comparable" column.
+const URBAN_DATA: &str =
+    "simulated: procedural street grid, routes and poles (only the date is NCLT's)";
+/// The "comparable" cell of the speed rows: the thesis' 0.5 M points/s beside ours.
+const SPEED_COMPARABLE: &str = "no — thesis: real NCLT HDL-32E scans, Python with a GPU on a \
+     2011 quad-core PC; ours: simulated scans, Rust on 2 shared CPU cores (same 0.2 m voxels)";
+
+/// The "comparable" cell of a session row beside the thesis' session of the same date;
+/// `ours` says what our data are.
+fn session_comparable(ours: &str, runs: usize) -> String {
+    let runs = if runs == 10 {
+        String::new()
+    } else {
+        format!("; {runs} runs per session (thesis 10)")
+    };
+    comparable::no(&format!(
+        "{ours}; thesis: the real NCLT session of that date (real scans, several km, map \
+         from real sessions){runs}"
+    ))
+}
+
+/// The protocol on `n` sessions opened (twice each: mapping, then localization) by `open`;
+/// `ours` says what the sessions' data are (for the "comparable" column).
 fn evaluate(
     ctx: &EvalContext,
     n: usize,
     runs: usize,
     seed_base: u64,
+    ours: &str,
     open: &dyn Fn(usize) -> Result<Session>,
 ) -> Result<Outcome> {
     let preset = Preset::nclt();
@@ -264,21 +292,7 @@ fn evaluate(
     );
 
     // 2. Localization of every session.
-    let mut table = Table::new([
-        "session",
-        "scans",
-        "f_map [%]",
-        "Δ_pos [m]",
-        "RMSE_pos [m]",
-        "Δ_ang [°]",
-        "RMSE_ang [°]",
-        "diverged runs",
-        "thesis f_map [%]",
-        "thesis Δ_pos [m]",
-        "thesis RMSE_pos [m]",
-        "thesis Δ_ang [°]",
-        "thesis RMSE_ang [°]",
-    ]);
+    let mut table = localization_table();
     let mut detection = Table::new([
         "session",
         "map poles ≤ 12 m",
@@ -297,6 +311,7 @@ fn evaluate(
         "updates",
         "update rate [Hz]",
         "aim [Hz]",
+        comparable::HEADER,
     ]);
     let mut results = Vec::new();
     let mut means = Vec::new();
@@ -363,6 +378,7 @@ fn evaluate(
             cell(thesis.map(|t| t.3), 3),
             cell(thesis.map(|t| t.4), 3),
             cell(thesis.map(|t| t.5), 3),
+            session_comparable(ours, runs),
         ]);
         let near_map = near(&map, &gt[..end], NEAR_M);
         let quality = detection_quality(&near_map, &session.truth, 1.0);
@@ -374,7 +390,9 @@ fn evaluate(
             fmt_num(quality.recall, 3),
             fmt_num(quality.mean_centre_error_m, 3),
         ]);
-        speed.row(speed_row(date, &totals, &run_results, 50.0));
+        let mut row = speed_row(date, &totals, &run_results, 50.0);
+        row.push(SPEED_COMPARABLE.to_owned());
+        speed.row(row);
         eprintln!(
             "  {date}: {end} scans, Δ_pos {:.3} m, RMSE {:.3} m, {} / {} diverged ({:.0} s)",
             s.mean_pos,
@@ -397,7 +415,7 @@ fn evaluate(
             },
         }));
     }
-    mean_rows(&mut table, &means);
+    mean_rows(&mut table, &means, ours);
     Ok(Outcome {
         localization: table,
         detection,
@@ -410,43 +428,91 @@ fn evaluate(
     })
 }
 
-/// "mean over sessions" and "mean without 2013-02-23" rows beside the thesis means.
-fn mean_rows(table: &mut Table, means: &[(String, [f64; 4])]) {
-    let mut row = |label: &str, rows: Vec<&[f64; 4]>, thesis: [&str; 2]| {
-        let n = rows.len().max(1) as f64;
-        let avg = |i: usize| fmt_num(rows.iter().map(|m| m[i]).sum::<f64>() / n, 3);
-        table.row([
-            label.to_string(),
-            "".into(),
-            "".into(),
-            avg(0),
-            avg(1),
-            avg(2),
-            avg(3),
-            "".into(),
-            "".into(),
-            thesis[0].into(),
-            "".into(),
-            thesis[1].into(),
-            "".into(),
-        ]);
-    };
+/// The localization table beside Table 12.1 (header only).
+fn localization_table() -> Table {
+    Table::new([
+        "session",
+        "scans",
+        "f_map [%]",
+        "Δ_pos [m]",
+        "RMSE_pos [m]",
+        "Δ_ang [°]",
+        "RMSE_ang [°]",
+        "diverged runs",
+        "thesis f_map [%]",
+        "thesis Δ_pos [m]",
+        "thesis RMSE_pos [m]",
+        "thesis Δ_ang [°]",
+        "thesis RMSE_ang [°]",
+        comparable::HEADER,
+    ])
+}
+
+/// "mean over sessions" and "mean without 2013-02-23" rows beside the thesis means (which
+/// are over all 27 (26) thesis sessions, not over the dates above: the "comparable" cell
+/// gives the thesis' Δ_pos over the same dates); `ours` says what our data are.
+fn mean_rows(table: &mut Table, means: &[(String, [f64; 4])], ours: &str) {
+    let mut row =
+        |label: &str, rows: &[&(String, [f64; 4])], thesis: [&str; 2], sessions: usize| {
+            let n = rows.len().max(1) as f64;
+            let avg = |i: usize| fmt_num(rows.iter().map(|m| m.1[i]).sum::<f64>() / n, 3);
+            let dates: Vec<&str> = rows.iter().map(|m| m.0.as_str()).collect();
+            let cell = comparable::no(&format!(
+                "{ours}; thesis: mean over its {sessions} real sessions{}",
+                thesis_mean_text(&dates)
+            ));
+            table.row([
+                label.to_string(),
+                "".into(),
+                "".into(),
+                avg(0),
+                avg(1),
+                avg(2),
+                avg(3),
+                "".into(),
+                "".into(),
+                thesis[0].into(),
+                "".into(),
+                thesis[1].into(),
+                "".into(),
+                cell,
+            ]);
+        };
     row(
         "mean over sessions",
-        means.iter().map(|m| &m.1).collect(),
+        &means.iter().collect::<Vec<_>>(),
         ["0.284", "0.801"],
+        thesis::TABLE_12_1.len(),
     );
     if means.iter().any(|m| m.0 == "2013-02-23") && means.len() > 1 {
         row(
             "mean without 2013-02-23",
-            means
+            &means
                 .iter()
                 .filter(|m| m.0 != "2013-02-23")
-                .map(|m| &m.1)
-                .collect(),
+                .collect::<Vec<_>>(),
             ["0.200", ""],
+            thesis::TABLE_12_1.len() - 1,
         );
     }
+}
+
+/// ", not the N dates above (over them: Δ_pos X m)" — the thesis' mean Δ_pos over the
+/// dates of our rows that Table 12.1 has; empty when none has.
+fn thesis_mean_text(dates: &[&str]) -> String {
+    let found: Vec<f64> = dates
+        .iter()
+        .filter_map(|d| thesis::row(d))
+        .map(|t| t.2)
+        .collect();
+    if found.is_empty() {
+        return String::new();
+    }
+    format!(
+        ", not the {} dates above (over them: Δ_pos {:.3} m)",
+        found.len(),
+        found.iter().sum::<f64>() / found.len() as f64
+    )
 }
 
 /// The report text.
@@ -713,4 +779,39 @@ fn session_dirs(root: &Path) -> Result<Vec<PathBuf>> {
         anyhow::bail!("no sessions under {}", root.display());
     }
     Ok(dirs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The mean rows fit the localization table and name the thesis' mean over the same
+    /// dates (Table 12.1's 0.284 m is over all 27 sessions).
+    #[test]
+    fn mean_rows_name_the_thesis_mean_over_the_same_dates() {
+        let mut table = localization_table();
+        let means = vec![
+            ("2012-01-08".to_owned(), [0.03, 0.04, 0.1, 0.14]),
+            ("2013-02-23".to_owned(), [0.05, 0.06, 0.1, 0.17]),
+        ];
+        mean_rows(&mut table, &means, SEMI_DATA);
+        let md = table.to_markdown().expect("rows fit the header");
+        let line = |start: &str| md.lines().find(|l| l.starts_with(start)).unwrap();
+        let all = line("| mean over sessions");
+        assert!(all.contains("| 0.284 "), "{all}");
+        assert!(all.contains("mean over its 27 real sessions"), "{all}");
+        // (0.130 + 2.470) / 2 = 1.300.
+        assert!(
+            all.contains("not the 2 dates above (over them: Δ_pos 1.300 m)"),
+            "{all}"
+        );
+        let without = line("| mean without 2013-02-23");
+        assert!(without.contains("its 26 real sessions"), "{without}");
+        assert!(without.contains("(over them: Δ_pos 0.130 m)"), "{without}");
+        assert!(
+            session_comparable(URBAN_DATA, 2).contains("2 runs per session (thesis 10)"),
+            "{}",
+            session_comparable(URBAN_DATA, 2)
+        );
+    }
 }

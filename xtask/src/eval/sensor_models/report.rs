@@ -6,7 +6,67 @@ use raypath_sensor_models::scoring::{ScoreReport, ScoreRow};
 use serde_json::json;
 
 use super::{DataSet, Kind};
+use crate::eval::comparable;
 use crate::table::{Table, fmt_num};
+
+/// Cell edge of the main 2-D tables, metres (`ScoringConfig::default()`).
+const CELL_2D_M: f64 = 0.1;
+/// Voxel edge of the simulated 3-D drive and of the thesis, metres.
+const VOXEL_3D_M: f64 = 0.5;
+
+/// Which metric a "comparable" cell is about: the inverse KL adds the unstated σ.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Metric {
+    /// D' or the ML/FMP ratios: no pose samples.
+    Likelihood,
+    /// The inverse KL of Table 7.3(b), whose ground-truth σ the thesis does not state.
+    InverseKl,
+}
+
+impl Metric {
+    fn caveat(self) -> &'static str {
+        match self {
+            Metric::Likelihood => "",
+            Metric::InverseKl => "; the thesis' σ of ĝ is unstated (ours 0.05 m)",
+        }
+    }
+}
+
+/// The "comparable" cell of one of our rows (`kind` at `cell_m`) beside the thesis' figures.
+fn ours_comparable(kind: Kind, cell_m: f64, metric: Metric) -> String {
+    let data = match kind {
+        Kind::Real => format!("real 2-D SICK scans of a Radish log, {cell_m} m cells"),
+        Kind::Sim2 => format!("simulated 2-D indoor world, {cell_m} m cells"),
+        Kind::Sim3 => format!("simulated HDL-64E urban drive, {VOXEL_3D_M} m voxels"),
+    };
+    comparable::no(&format!(
+        "{data}; thesis: real 3-D HDL-64E drives at {VOXEL_3D_M} m voxels; orderings only{}",
+        metric.caveat()
+    ))
+}
+
+/// The "comparable" cell of a thesis row (campus, forest or park).
+fn thesis_comparable(metric: Metric) -> String {
+    comparable::no(&format!(
+        "real 3-D HDL-64E drive (VIONA robot, Applanix poses, {VOXEL_3D_M} m voxels), not \
+         available here; none of our rows uses it{}",
+        metric.caveat()
+    ))
+}
+
+/// The "comparable" cell of an agreement row (`label` names the check); `ours` says what
+/// our data sets are.
+fn agreement_comparable(label: &str, ours: &str) -> String {
+    let metric = if label.starts_with("inverse KL") {
+        Metric::InverseKl
+    } else {
+        Metric::Likelihood
+    };
+    comparable::no(&format!(
+        "orderings on {ours} vs the thesis' real 3-D HDL-64E drives at {VOXEL_3D_M} m voxels{}",
+        metric.caveat()
+    ))
+}
 
 /// Columns of the per-model tables: (row model, posterior, header).
 const COLUMNS: [(&str, bool, &str); 7] = [
@@ -165,9 +225,19 @@ pub fn agreement_json(sets: &[DataSet]) -> serde_json::Value {
         .collect()
 }
 
-fn model_table(sets: &[DataSet], f: fn(&ScoreRow) -> f64, format: fn(f64) -> String) -> Table {
+/// Our per-model table; with `beside_thesis` (the cell edge of the 2-D rows and the metric) a
+/// "comparable" column.
+fn model_table(
+    sets: &[DataSet],
+    f: fn(&ScoreRow) -> f64,
+    format: fn(f64) -> String,
+    beside_thesis: Option<(f64, Metric)>,
+) -> Table {
     let mut headers = vec!["data set", "kind", "test scans", "rays"];
     headers.extend(COLUMNS.iter().map(|c| c.2));
+    if beside_thesis.is_some() {
+        headers.push(comparable::HEADER);
+    }
     let mut table = Table::new(headers);
     for set in sets {
         let mut cells = vec![
@@ -181,6 +251,9 @@ fn model_table(sets: &[DataSet], f: fn(&ScoreRow) -> f64, format: fn(f64) -> Str
                 .iter()
                 .map(|(m, p, _)| format(value(&set.report, m, *p, f))),
         );
+        if let Some((cell_m, metric)) = beside_thesis {
+            cells.push(ours_comparable(set.kind, cell_m, metric));
+        }
         table.row(cells);
     }
     table
@@ -219,24 +292,47 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> Result<String
     }
 
     md.push_str("### (a) D'(g‖h), summed over all scored rays (lower is better)\n\n");
-    md.push_str(&model_table(sets, |r| r.neg_log_likelihood, sci).to_markdown()?);
+    md.push_str(
+        &model_table(
+            sets,
+            |r| r.neg_log_likelihood,
+            sci,
+            Some((CELL_2D_M, Metric::Likelihood)),
+        )
+        .to_markdown()?,
+    );
     md.push_str("\nThesis Table 7.3(a), 3-D VIONA data:\n\n");
-    let mut thesis = Table::new(["data set", "DEC", "REF", "END"]);
+    let mut thesis = Table::new(["data set", "DEC", "REF", "END", comparable::HEADER]);
     for (name, d, _) in THESIS_73 {
-        thesis.row([name.to_owned(), sci(d[0]), sci(d[1]), sci(d[2])]);
+        thesis.row([
+            name.to_owned(),
+            sci(d[0]),
+            sci(d[1]),
+            sci(d[2]),
+            thesis_comparable(Metric::Likelihood),
+        ]);
     }
     md.push_str(&thesis.to_markdown()?);
 
     md.push_str("\n### (b) Inverse KL D(h‖g), averaged over test scans (lower is better)\n\n");
-    md.push_str(&model_table(sets, |r| r.inverse_kl, |v| fmt_num(v, 2)).to_markdown()?);
+    md.push_str(
+        &model_table(
+            sets,
+            |r| r.inverse_kl,
+            |v| fmt_num(v, 2),
+            Some((CELL_2D_M, Metric::InverseKl)),
+        )
+        .to_markdown()?,
+    );
     md.push_str("\nThesis Table 7.3(b):\n\n");
-    let mut thesis = Table::new(["data set", "DEC", "REF", "END"]);
+    let mut thesis = Table::new(["data set", "DEC", "REF", "END", comparable::HEADER]);
     for (name, _, k) in THESIS_73 {
         thesis.row([
             name.to_owned(),
             fmt_num(k[0], 2),
             fmt_num(k[1], 2),
             fmt_num(k[2], 2),
+            thesis_comparable(Metric::InverseKl),
         ]);
     }
     md.push_str(&thesis.to_markdown()?);
@@ -259,6 +355,7 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> Result<String
         "D' gain DEC (nats/ray)",
         "KL ratio REF",
         "KL ratio DEC",
+        comparable::HEADER,
     ]);
     for set in sets {
         let r = &set.report;
@@ -271,6 +368,7 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> Result<String
             fmt_num(d_gain_per_ray(r, "decay-rate"), 3),
             fmt_num(kl_ratio(r, "reflection"), 3),
             fmt_num(kl_ratio(r, "decay-rate"), 3),
+            ours_comparable(set.kind, CELL_2D_M, Metric::Likelihood),
         ]);
     }
     md.push_str(&ratios.to_markdown()?);
@@ -288,6 +386,7 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> Result<String
         "log-lik. ratio DEC",
         "KL ratio REF",
         "KL ratio DEC",
+        comparable::HEADER,
     ]);
     for (name, l, k) in THESIS_8 {
         thesis.row([
@@ -296,11 +395,12 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> Result<String
             fmt_num(l[1], 2),
             fmt_num(k[0], 2),
             fmt_num(k[1], 2),
+            thesis_comparable(Metric::Likelihood),
         ]);
     }
     md.push_str(&thesis.to_markdown()?);
     md.push_str("\nKL to truth per model (summed over test scans, nats):\n\n");
-    md.push_str(&model_table(sets, |r| r.kl_ground_truth, |v| fmt_num(v, 1)).to_markdown()?);
+    md.push_str(&model_table(sets, |r| r.kl_ground_truth, |v| fmt_num(v, 1), None).to_markdown()?);
 
     md.push_str("\n### (d) Speed in this run\n\n");
     let mut headers = vec![
@@ -345,6 +445,7 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> Result<String
         "simulated 2-D",
         "simulated 3-D",
         "fails on",
+        comparable::HEADER,
     ]);
     let tallies = tally(sets);
     let frac = |(h, n): (usize, usize)| {
@@ -365,6 +466,10 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> Result<String
             } else {
                 failing.join(", ")
             },
+            agreement_comparable(
+                label,
+                "real 2-D logs at 0.1 m cells, simulated 2-D worlds and a simulated 3-D drive",
+            ),
         ]);
     }
     md.push_str(&agreement.to_markdown()?);
@@ -427,13 +532,35 @@ pub fn coarse_section(sets: &[DataSet], cell_m: f64) -> Result<String> {
          cell edge. Coarser cells make the ray-casting models' likelihoods smoother in the pose, \
          which is the regime of the thesis's 0.5 m voxels.\n\nD'(g‖h):\n\n"
     );
-    md.push_str(&model_table(sets, |r| r.neg_log_likelihood, sci).to_markdown()?);
+    md.push_str(
+        &model_table(
+            sets,
+            |r| r.neg_log_likelihood,
+            sci,
+            Some((cell_m, Metric::Likelihood)),
+        )
+        .to_markdown()?,
+    );
     md.push_str("\nInverse KL D(h‖g):\n\n");
-    md.push_str(&model_table(sets, |r| r.inverse_kl, |v| fmt_num(v, 2)).to_markdown()?);
+    md.push_str(
+        &model_table(
+            sets,
+            |r| r.inverse_kl,
+            |v| fmt_num(v, 2),
+            Some((cell_m, Metric::InverseKl)),
+        )
+        .to_markdown()?,
+    );
     md.push_str(&format!(
         "\nAgreement with the thesis's orderings at {cell_m} m:\n\n"
     ));
-    let mut agreement = Table::new(["ordering in the thesis", "real 2-D", "fails on"]);
+    let mut agreement = Table::new([
+        "ordering in the thesis",
+        "real 2-D",
+        "fails on",
+        comparable::HEADER,
+    ]);
+    let ours = format!("real 2-D logs at {cell_m} m cells");
     for (label, counts, failing) in tally(sets) {
         agreement.row([
             label.to_owned(),
@@ -443,8 +570,78 @@ pub fn coarse_section(sets: &[DataSet], cell_m: f64) -> Result<String> {
             } else {
                 failing.join(", ")
             },
+            agreement_comparable(label, &ours),
         ]);
     }
     md.push_str(&agreement.to_markdown()?);
     Ok(md)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn data_set(name: &str, kind: Kind) -> DataSet {
+        let rows = COLUMNS
+            .iter()
+            .enumerate()
+            .map(|(k, (model, posterior, _))| ScoreRow {
+                model: (*model).to_owned(),
+                posterior: *posterior,
+                neg_log_likelihood: 1000.0 + 100.0 * k as f64,
+                inverse_kl: 10.0 + k as f64,
+                kl_ground_truth: 50.0 - k as f64,
+                evaluations: 1000,
+                seconds: 0.1,
+            })
+            .collect();
+        DataSet {
+            name: name.to_owned(),
+            kind,
+            scans: 10,
+            report: ScoreReport {
+                rows,
+                mapping_scans: 5,
+                mapping_rays: 900,
+                mapping_seconds: 0.01,
+                test_scans: 5,
+                test_rays: 900,
+                grid_dims: [10, 10, 1],
+                resolution_m: CELL_2D_M,
+                max_range_m: 30.0,
+            },
+        }
+    }
+
+    /// The report renders from a small known input (every row has the header's cell count)
+    /// and every table beside the thesis has a "comparable" column saying why not.
+    #[test]
+    fn tables_beside_the_thesis_say_what_compares() {
+        let sets = [
+            data_set("intel", Kind::Real),
+            data_set("office", Kind::Sim2),
+            data_set("urban-kitti", Kind::Sim3),
+        ];
+        let md = markdown(&sets, "test plan", &[]).expect("report renders");
+        let headers: Vec<&str> = md.lines().filter(|l| l.starts_with("| data set")).collect();
+        // (a), thesis (a), (b), thesis (b), (c), thesis 8.2/8.3 with the column; the KL per
+        // model and the speed table without it.
+        let with: Vec<&&str> = headers
+            .iter()
+            .filter(|h| comparable::last_cell(h) == "comparable")
+            .collect();
+        assert_eq!(with.len(), 6, "{headers:#?}");
+        assert_eq!(headers.len(), 8, "{headers:#?}");
+        let line = |start: &str| md.lines().find(|l| l.starts_with(start)).unwrap();
+        assert!(line("| intel ").contains("no — real 2-D SICK scans of a Radish log, 0.1 m"));
+        assert!(line("| office ").contains("no — simulated 2-D indoor world"));
+        assert!(line("| urban-kitti ").contains("simulated HDL-64E urban drive, 0.5 m voxels"));
+        assert!(line("| campus ").contains("no — real 3-D HDL-64E drive"));
+        let agreement = line("| inverse KL: DEC best");
+        assert!(agreement.contains("σ of ĝ is unstated"), "{agreement}");
+
+        let coarse = coarse_section(&sets[..1], 0.5).expect("section renders");
+        assert!(coarse.contains("real 2-D SICK scans of a Radish log, 0.5 m cells"));
+        assert!(coarse.contains("orderings on real 2-D logs at 0.5 m cells"));
+    }
 }
