@@ -3,7 +3,9 @@
 //!
 //! Both stop when the relative change of the log-likelihood between two accepted iterates
 //! falls below [`FitConfig::relative_tolerance`] (`1e-3`, Sec. 9.5.3) and both only accept
-//! steps that increase the log-likelihood, so its history is monotone.
+//! steps that increase the log-likelihood, so its history is monotone. "Log-likelihood"
+//! here is the [`FitProblem`]'s objective: the rays' log-likelihood plus the log-prior
+//! ([`FitProblem::log_prior`]; the MAP rather than the plain ML map, see the crate docs).
 
 use std::time::Instant;
 
@@ -52,7 +54,9 @@ impl Default for FitConfig {
 pub struct FitReport {
     /// Accepted iterations.
     pub iterations: usize,
-    /// Log-likelihood of the start and after each accepted iteration (non-decreasing).
+    /// The objective — log-likelihood of the rays plus the log-prior
+    /// ([`FitProblem::log_prior`]) — at the start and after each accepted iteration
+    /// (non-decreasing).
     pub log_likelihoods: Vec<f64>,
     /// Log-likelihood evaluations (incl. rejected trials).
     pub evaluations: usize,
@@ -63,7 +67,8 @@ pub struct FitReport {
 }
 
 impl FitReport {
-    /// The final log-likelihood.
+    /// The final objective (log-likelihood plus log-prior, see
+    /// [`log_likelihoods`](Self::log_likelihoods)).
     pub fn log_likelihood(&self) -> f64 {
         self.log_likelihoods
             .last()

@@ -18,8 +18,9 @@
 //! Along a ray `s + v t` the optical depth `𝒮 = ∫ λ dt` has a closed form (Eq. 9.9–9.10), so
 //! a ray's likelihood — `λ(r) e^{−𝒮(r)}` for a return, `1 − e^{−𝒮(r_min)}` for `sub`,
 //! `e^{−𝒮}` for `super` (Eq. 9.5, 9.11, 9.12) — comes straight from the coefficients, with
-//! no rasterization. The map is the maximum-likelihood coefficient set, found by Newton's
-//! method with analytic derivatives (Sec. 9.4.4).
+//! no rasterization. The map is the maximum-likelihood coefficient set of Sec. 9.4.4 under
+//! a weak prior `−ρ ∬ λ` that keeps `λ` bounded where no ray passes (see "Prior" below),
+//! found by Newton's method with analytic derivatives.
 //!
 //! ## Making it fast (exact rearrangements, not approximations)
 //!
@@ -58,7 +59,7 @@
 //! |---|---|
 //! | [`DctMap`] | coefficients, `λ` at a point in `O(I)`, on a lattice, optical depth, ray log-likelihood |
 //! | [`MapRay`], [`Outcome`], [`Patch`], [`RangeLimits`] | rays in the map frame; clipping world rays to a patch |
-//! | [`FitProblem`], [`fit`], [`FitConfig`], [`Solver`], [`FitReport`] | ML fit (trust-region Newton or L-BFGS) |
+//! | [`FitProblem`], [`fit`], [`FitConfig`], [`Solver`], [`FitReport`] | ML fit under a weak prior (trust-region Newton or L-BFGS) |
 //! | [`derivatives`] | per-ray gradient and Hessian in the thesis's `B`/`C` notation |
 //! | [`GridRateMap`], [`initial_map`], [`DctMap::from_grid`], [`DctMap::to_rate_grid`] | the grid baseline (ch. 7) and conversions |
 //! | [`render`] | PNG of `p_ref = 1 − e^{−λ}` |
@@ -73,6 +74,7 @@
 //! | initialization | grid decay-rate map with `L × M` cells, `√λ` transformed | thesis silent; never `𝒜 = 0` (a saddle) |
 //! | [`RangeLimits`] | `r_min = 0`, `r_max = ∞` | CARMEN logs have no `sub` readings; no-returns are decoded by the reader |
 //! | [`RIDGE_FACTOR`] | `δ = 1e-10 · max K_ii` | not in the thesis; numerical safeguard (below) |
+//! | [`PRIOR_PATH_DENSITY`] | `ρ = 1 /m` (prior `−ρ ∬ λ dx dy`) | not in ch. 9 (bare ML); the rate part of the gamma prior of Sec. 8.4.3, made continuous (below) |
 //!
 //! ## Errata and decisions
 //!
@@ -92,6 +94,41 @@
 //!   without bound (to 7·10⁹ on the aces log). A ridge `−δ ‖a‖²` with
 //!   `δ = 1e-10 · max K_ii` ([`FitProblem::set_ridge_factor`]) stops it; on 10⁴ rays it
 //!   changes the log-likelihood by well under one nat per thousand rays.
+//! * **Prior** ([`FitProblem::set_prior_path_density`], default [`PRIOR_PATH_DENSITY`]
+//!   `ρ = 1 /m`). The thesis maximizes the bare likelihood (Sec. 9.4.4) and, in Sec. 9.5.2,
+//!   scores maps on the rays they were built from. The likelihood does not constrain `λ`
+//!   where no mapping ray passes (behind walls, in patch corners, in gaps between scans —
+//!   the "random values" in unexplored areas of Sec. 3.3, the missing "unexplored areas" of
+//!   Sec. 9.6), and the ML fit parks huge rates there: on the CARMEN patches of `cargo xtask
+//!   eval dct` the 40 × 40 csail map reaches `λ = 2·10⁴ /m` in a 0.3 m hole that no
+//!   mapping ray enters or ends in, and the one held-back no-return ray crossing it gets
+//!   `ln p = −6517` (optical depth 6517; the grid: −13), which makes the held-back
+//!   difference DCT − grid −6372 for the whole log; belgioioso 40² (−100, worst ray −349)
+//!   and csail 29² (−37, worst ray −237) fail the same way, and aces 10² holds
+//!   `λ = 4·10⁷ /m` in a corner no ray reaches. It is not `λ → 0` (Eq. 9.6 squares `g`, so
+//!   `λ ≥ 0`; the worst held-back *hits* score −5 and −12 on those two maps), nor an early
+//!   stop (at a relative tolerance of 1e-7 instead of 1e-3 the fits take 7 iterations
+//!   instead of 4 and give the same −6371 and −101). The numerical ridge above is a prior
+//!   of this kind, but `δ ≈ 2.5·10⁻⁶` there amounts to `ρ ≈ 10⁻⁷ /m`. The fix is a prior of
+//!   physical size:
+//!   the rate part `β` of the conjugate gamma prior on decay rates of Sec. 8.4.3 (Eq. 8.17,
+//!   `Gamma(H + α, R + β)`: `β` metres of virtual unreflected path per voxel) made
+//!   continuous, `ln p(𝒜) = −ρ ∬ λ dx dy`, i.e. `ρ` metres of virtual no-return ray per m²
+//!   everywhere — on 10 m × 10 m about 10 rays crossing the patch, against 10⁴ mapping
+//!   rays. By Parseval it is a diagonal ridge on `a`, so a fit costs the same. (The shape
+//!   part `α` has no closed form for a continuous map and, with `α < 1` as Sec. 8.5's
+//!   moment matching gives on these logs, would reward `λ → 0`; it is not used.)
+//!   Measured on the 10 logs of `cargo xtask eval dct` (500 held-back rays): at 40² the
+//!   mean difference DCT − grid goes from −568.6 ± 2040.9 (8 of 10 above the grid) to
+//!   +109.6 ± 71.2 (10 of 10; csail −6371 → +118, belgioioso −100 → +209, worst log +6.6);
+//!   29² from 101.2 to 112.9 (10 of 10); at 10², 13², 20² the means move from 126.7, 123.0,
+//!   117.4 to 111.2, 110.5, 105.4, every log keeping its sign — the loss is almost all
+//!   aces (511 → 372 at 10²), whose ML maps gain on the held-back rays from rates of
+//!   10⁷ /m outside the data; RMSE of `p_ref` is unchanged to ±0.001 at every size.
+//!   `ρ = 0.1` still leaves csail 40² at −64 and 20 000 held-back rays on belgioioso 40²
+//!   find a ray at −866; `ρ = 1` and `ρ = 3` differ by a few nats; the empirical-Bayes `β` of
+//!   Sec. 8.5 (moment matching on the `L × M` grid), per cell area, varies 10⁴-fold between
+//!   logs and sizes (0.005–57 /m) and is lowest on aces, so a fixed density was chosen. `0` restores the thesis's plain ML fit.
 //! * **Solver.** Trust-region Newton (Levenberg–Marquardt damping on the exact Hessian, with
 //!   step doubling while the quadratic model is accurate) is the default: it reaches the
 //!   thesis's stopping rule in 4–6 iterations, while L-BFGS stops early under the same
@@ -119,7 +156,7 @@ pub use error::DctError;
 pub use fit::{FitConfig, FitReport, Solver, fit};
 pub use grid::{GridRateMap, initial_map};
 pub use map::DctMap;
-pub use objective::{Evaluation, FitProblem, RIDGE_FACTOR};
+pub use objective::{Evaluation, FitProblem, PRIOR_PATH_DENSITY, RIDGE_FACTOR};
 pub use ray::{MapRay, Outcome, Patch, RangeLimits};
 pub use spectrum::{
     Shape, fill_product_matrix, product_matrix, product_matrix_times, self_convolution,

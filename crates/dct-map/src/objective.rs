@@ -9,6 +9,12 @@
 //! the same product-to-sum trick, so the full Hessian is `−2 K(T + U)` plus the rare `sub`
 //! terms. Without `sub` rays the negative log-likelihood is therefore convex on every
 //! region where the signs of all `g_k` are fixed (a log barrier at `g_k = 0`).
+//!
+//! The optimized objective adds a log-prior to the log-likelihood: the prior
+//! `−ρ ∬ λ dx dy` ([`FitProblem::set_prior_path_density`]) and the numerical ridge
+//! `−δ ‖a‖²` ([`FitProblem::set_ridge_factor`]). Both are diagonal quadratics in `a`
+//! (the prior by Parseval), so they add `2 w_i` to the Hessian's diagonal and keep its
+//! structure; [`FitProblem::log_prior`] returns their value.
 
 use rayon::prelude::*;
 
@@ -36,15 +42,26 @@ pub struct FitProblem {
     rays: usize,
     /// Weight `δ` of the ridge `−δ ‖a‖²` added to the log-likelihood.
     ridge: f64,
+    /// Path-length density `ρ` (1/m) of the prior `−ρ ∬ λ dx dy`.
+    prior: f64,
+    /// `w_i` of the log-prior `−Σ_i w_i a_i²` (ridge plus prior, by Parseval).
+    penalty: Vec<f64>,
 }
 
 /// Default ridge factor: `δ = RIDGE_FACTOR · max_i K_ii` (see [`FitProblem::set_ridge_factor`]).
 pub const RIDGE_FACTOR: f64 = 1e-10;
 
-/// Value, gradient (and optionally Hessian) of the log-likelihood at one point.
+/// Default path-length density `ρ = 1 /m` of the prior `−ρ ∬ λ dx dy` (see
+/// [`FitProblem::set_prior_path_density`]): one metre of virtual, unreflected ray per square
+/// metre — on a 10 m × 10 m patch as much as 10 rays crossing it, against the 10⁴ mapping
+/// rays of Sec. 9.5.
+pub const PRIOR_PATH_DENSITY: f64 = 1.0;
+
+/// Value, gradient (and optionally Hessian) of the objective at one point.
 #[derive(Clone, Debug)]
 pub struct Evaluation {
-    /// `Σ_k ln p(z_k | 𝒜)`.
+    /// The objective `Σ_k ln p(z_k | 𝒜) + ln p(𝒜)`: the log-likelihood plus the log-prior
+    /// ([`FitProblem::log_prior`]).
     pub log_likelihood: f64,
     /// Its gradient.
     pub gradient: Vec<f64>,
@@ -106,8 +123,10 @@ impl FitProblem {
         let k_total = product_matrix(shape, &t_total);
         let n = shape.len();
         let max_diag = (0..n).map(|i| k_total[i * n + i]).fold(0.0, f64::max);
-        Ok(Self {
+        let mut problem = Self {
             ridge: RIDGE_FACTOR * max_diag,
+            prior: PRIOR_PATH_DENSITY,
+            penalty: Vec::new(),
             shape,
             extent_m,
             t_total,
@@ -116,7 +135,58 @@ impl FitProblem {
             hit_cy,
             subs,
             rays: rays.len(),
-        })
+        };
+        problem.update_penalty();
+        Ok(problem)
+    }
+
+    fn update_penalty(&mut self) {
+        let area = self.extent_m[0] * self.extent_m[1];
+        let half = |k: usize| if k == 0 { 1.0 } else { 0.5 };
+        let mm = self.shape.m;
+        self.penalty = (0..self.shape.len())
+            .map(|i| self.ridge + self.prior * area * half(i / mm) * half(i % mm))
+            .collect();
+    }
+
+    fn penalty_value(&self, a: &[f64]) -> f64 {
+        a.iter().zip(&self.penalty).map(|(a, w)| w * a * a).sum()
+    }
+
+    /// The log-prior `−ρ ∬ λ dx dy − δ ‖a‖²` at `a` (up to a constant): what the fit's
+    /// objective ([`log_likelihood`](Self::log_likelihood), [`evaluate`](Self::evaluate),
+    /// [`FitReport::log_likelihoods`](crate::FitReport::log_likelihoods)) adds to the
+    /// log-likelihood of the rays.
+    pub fn log_prior(&self, a: &[f64]) -> f64 {
+        -self.penalty_value(a)
+    }
+
+    /// Sets the path-length density `ρ` (1/m, metres of ray per m²) of the prior
+    /// `ln p(𝒜) = −ρ ∬ λ(x, y) dx dy + const` over the map (`0`: the thesis's plain
+    /// likelihood; default [`PRIOR_PATH_DENSITY`]).
+    ///
+    /// It is the rate half of the conjugate gamma prior of Sec. 8.4.3 (Eq. 8.17: the belief
+    /// `Gamma(H_i + α, R_i + β)` counts `β` metres of virtual ray path in every voxel) made
+    /// continuous: as if rays of total length `ρ` per m² had crossed every part of the map
+    /// without reflection. Where real rays pass (hundreds of metres per m² in the
+    /// experiments) it is negligible; where none pass — behind walls, in corners, in gaps
+    /// between scans — it is all that constrains `λ`, and without it the ML fit parks
+    /// arbitrarily large rates there (`λ` up to 10⁴–10⁷ /m on the CARMEN patches, see the
+    /// crate docs' "Prior" entry). By Parseval it is a diagonal ridge,
+    /// `∬ g² = X Y Σ_lm c_l c_m a_lm²` with `c_0 = 1`, `c_{k>0} = ½`, so it adds nothing to
+    /// the cost of a fit. Negative or non-finite values are treated as `0`.
+    pub fn set_prior_path_density(&mut self, rho_per_m: f64) {
+        self.prior = if rho_per_m.is_finite() {
+            rho_per_m.max(0.0)
+        } else {
+            0.0
+        };
+        self.update_penalty();
+    }
+
+    /// The prior's path-length density `ρ` (1/m).
+    pub fn prior_path_density(&self) -> f64 {
+        self.prior
     }
 
     /// Sets the ridge to `factor · max_i K_ii` (`0` for the plain likelihood).
@@ -132,6 +202,7 @@ impl FitProblem {
         let n = self.shape.len();
         let max_diag = (0..n).map(|i| self.k_total[i * n + i]).fold(0.0, f64::max);
         self.ridge = factor.max(0.0) * max_diag;
+        self.update_penalty();
     }
 
     /// The ridge weight `δ` (log-likelihood `− δ ‖a‖²`).
@@ -182,7 +253,8 @@ impl FitProblem {
             .collect()
     }
 
-    /// The log-likelihood `Σ ln g_k² − aᵀ K a + Σ_sub ln(1 − e^{−𝒮_k})` (Sec. 9.4.4).
+    /// The objective: the log-likelihood `Σ ln g_k² − aᵀ K a + Σ_sub ln(1 − e^{−𝒮_k})`
+    /// (Sec. 9.4.4) plus the [`log_prior`](Self::log_prior).
     pub fn log_likelihood(&self, a: &[f64]) -> f64 {
         let g = self.amplitudes(a);
         let ka = self.quadratic(a);
@@ -200,11 +272,12 @@ impl FitProblem {
                 })
                 .sum()
         };
-        let v = hits - quad + subs - self.ridge * a.iter().map(|a| a * a).sum::<f64>();
+        let v = hits - quad + subs - self.penalty_value(a);
         if v.is_nan() { f64::NEG_INFINITY } else { v }
     }
 
-    /// Log-likelihood and gradient. `O(K · I + I²)` plus `O(I²)` per `sub` ray.
+    /// Objective (log-likelihood plus log-prior) and its gradient. `O(K · I + I²)` plus
+    /// `O(I²)` per `sub` ray.
     pub fn evaluate(&self, a: &[f64]) -> Evaluation {
         let (n, lm, mm, pn, qn) = (
             self.shape.len(),
@@ -246,7 +319,8 @@ impl FitProblem {
         gradient
             .iter_mut()
             .zip(&ka)
-            .for_each(|(g, k)| *g -= 2.0 * k);
+            .zip(a.iter().zip(&self.penalty))
+            .for_each(|((g, k), (a, w))| *g -= 2.0 * (k + w * a));
         let mut subs = 0.0;
         if !self.subs.is_empty() {
             let b = self_convolution(self.shape, a);
@@ -260,7 +334,7 @@ impl FitProblem {
                 gradient.iter_mut().zip(&kv).for_each(|(g, k)| *g += w * k);
             }
         }
-        let v = hits - quad + subs - self.ridge * a.iter().map(|a| a * a).sum::<f64>();
+        let v = hits - quad + subs - self.penalty_value(a);
         Evaluation {
             log_likelihood: if v.is_nan() { f64::NEG_INFINITY } else { v },
             gradient,
@@ -268,9 +342,9 @@ impl FitProblem {
         }
     }
 
-    /// The Hessian of the **negative** log-likelihood, row-major `I × I`, at `a` with hit
+    /// The Hessian of the **negative** objective, row-major `I × I`, at `a` with hit
     /// amplitudes `g` (from [`evaluate`](Self::evaluate)): `2 K(T + U)` plus the `sub` terms
-    /// (corrected erratum, see [`crate::derivatives`]).
+    /// (corrected erratum, see [`crate::derivatives`]) plus the log-prior's diagonal `2 w_i`.
     pub fn negative_hessian(&self, a: &[f64], g: &[f64]) -> Vec<f64> {
         let (n, pn, qn) = (self.shape.len(), self.shape.p(), self.shape.q());
         let u = self
@@ -304,8 +378,8 @@ impl FitProblem {
             .collect();
         let mut h = vec![0.0; n * n];
         fill_product_matrix(self.shape, &sum, |i, j, v| h[i * n + j] = v);
-        for i in 0..n {
-            h[i * n + i] += 2.0 * self.ridge;
+        for (i, w) in self.penalty.iter().enumerate() {
+            h[i * n + i] += 2.0 * w;
         }
         if !self.subs.is_empty() {
             let b = self_convolution(self.shape, a);

@@ -104,6 +104,7 @@ fn aggregated_objective_equals_the_sum_over_rays() {
         .collect();
     let mut problem = FitProblem::new(extent, map.shape(), &rays).unwrap();
     problem.set_ridge_factor(0.0);
+    problem.set_prior_path_density(0.0);
     let e = problem.evaluate(map.coefficients());
     let h = problem.negative_hessian(map.coefficients(), &e.amplitudes);
     let (mut ll, mut grad, mut hess) = (0.0, vec![0.0; n], vec![0.0; n * n]);
@@ -121,5 +122,63 @@ fn aggregated_objective_equals_the_sum_over_rays() {
     }
     for (a, b) in hess.iter().zip(&h) {
         assert!((a + b).abs() < 1e-8 * a.abs().max(1.0), "{a} vs −{b}");
+    }
+}
+
+#[test]
+fn prior_is_the_integral_of_the_rate_and_enters_the_derivatives() {
+    let extent = [6.0, 5.0];
+    let map = random_map(19, extent, Shape { l: 4, m: 3 });
+    let a = map.coefficients().to_vec();
+    let n = a.len();
+    let mut r = rng(20);
+    let rays: Vec<MapRay> = (0..20)
+        .map(|k| {
+            let outcome = [Outcome::Hit, Outcome::Super, Outcome::Sub][k % 3];
+            random_ray(&mut r, extent, outcome)
+        })
+        .collect();
+    let mut problem = FitProblem::new(extent, map.shape(), &rays).unwrap();
+    problem.set_ridge_factor(0.0);
+    let rho = 0.7;
+    problem.set_prior_path_density(rho);
+    // −ρ ∬ λ by the midpoint rule (exact for these frequencies) on a 64 × 64 lattice.
+    let cell = extent[0] * extent[1] / (64.0 * 64.0);
+    let integral: f64 = map.rates_on_lattice(64, 64).iter().sum::<f64>() * cell;
+    let prior = problem.log_prior(&a);
+    assert!(
+        (prior + rho * integral).abs() < 1e-10 * integral,
+        "{prior} vs {}",
+        -rho * integral
+    );
+    let plain = map.log_likelihood(&rays);
+    assert!((problem.log_likelihood(&a) - (plain + prior)).abs() < 1e-9 * plain.abs());
+    // Gradient and Hessian of the whole objective (with the ridge, too) by central differences.
+    problem.set_ridge_factor(1e-3);
+    let e = problem.evaluate(&a);
+    let hess = problem.negative_hessian(&a, &e.amplitudes);
+    let h = 1e-5;
+    for i in 0..n {
+        let (mut up, mut down) = (a.clone(), a.clone());
+        up[i] += h;
+        down[i] -= h;
+        let fd = (problem.log_likelihood(&up) - problem.log_likelihood(&down)) / (2.0 * h);
+        assert!(
+            (fd - e.gradient[i]).abs() < 1e-6 * fd.abs().max(1.0),
+            "grad {i}: fd {fd} vs {}",
+            e.gradient[i]
+        );
+        let (gu, gd) = (
+            problem.evaluate(&up).gradient,
+            problem.evaluate(&down).gradient,
+        );
+        for j in 0..n {
+            let fd = (gu[j] - gd[j]) / (2.0 * h);
+            let an = -hess[j * n + i];
+            assert!(
+                (fd - an).abs() < 1e-5 * fd.abs().max(1.0),
+                "hess {i},{j}: fd {fd} vs {an}"
+            );
+        }
     }
 }

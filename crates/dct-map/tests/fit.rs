@@ -8,8 +8,8 @@ use common::rng;
 use nalgebra::Point2;
 use rand::Rng;
 use raypath_dct_map::{
-    FitConfig, FitProblem, GridRateMap, MapRay, Outcome, Patch, RangeLimits, Shape, Solver, fit,
-    initial_map,
+    FitConfig, FitProblem, GridRateMap, MapRay, Outcome, PRIOR_PATH_DENSITY, Patch, RangeLimits,
+    Shape, Solver, fit, initial_map,
 };
 use raypath_geometry::{Range, Ray2};
 
@@ -63,7 +63,8 @@ fn both_solvers_increase_the_likelihood_monotonically() {
             );
         }
         let last = report.log_likelihoods.len() - 1;
-        let ll = map.log_likelihood(&rays);
+        // The report holds the objective: the rays' log-likelihood plus the log-prior.
+        let ll = map.log_likelihood(&rays) + problem.log_prior(map.coefficients());
         assert!((ll - report.log_likelihoods[last]).abs() < 1e-6 * ll.abs());
         // The wall is denser than the free space in front of it.
         assert!(
@@ -190,4 +191,45 @@ fn clipping_follows_the_table() {
             .clip_ray(&Ray2::from_angle(o, 0.0, Range::Hit(0.1)), &lim)
             .is_none()
     );
+}
+
+/// A vertical no-return ray at `x` through the whole 8 m room.
+fn crossing(x: f64) -> MapRay {
+    MapRay::from_angle([x, 0.0], std::f64::consts::FRAC_PI_2, 8.0, Outcome::Super)
+}
+
+#[test]
+fn the_prior_keeps_the_shadow_behind_a_wall_free_of_rate_spikes() {
+    // No mapping ray reaches x > 6.15 m for y ∈ [2, 6] (the wall's shadow). Without a prior
+    // the ML map parks rates of 10⁵–10⁶ /m there, and a new ray crossing the shadow gets a
+    // log-likelihood of about −10⁵ (the csail 40² failure of `cargo xtask eval dct`, small).
+    let extent = [8.0, 8.0];
+    let rays = room_rays(2000, 100);
+    let shape = Shape { l: 16, m: 16 };
+    let init = initial_map(extent, shape, &rays).unwrap();
+    let grid = GridRateMap::square(8.0, 16, &rays).unwrap();
+    let probes = [crossing(7.0), crossing(7.5), crossing(7.9)];
+    let worst = |ll: &dyn Fn(&MapRay) -> f64| probes.iter().map(ll).fold(f64::INFINITY, f64::min);
+    let grid_worst = worst(&|r| grid.ray_log_likelihood(r));
+    assert!(grid_worst > -5.0, "grid {grid_worst}");
+
+    let mut plain = FitProblem::new(extent, shape, &rays).unwrap();
+    plain.set_prior_path_density(0.0);
+    let (ml, _) = fit(&plain, init.coefficients(), &FitConfig::default()).unwrap();
+    let ml_worst = worst(&|r| ml.ray_log_likelihood(r));
+    assert!(ml_worst < -1e4, "plain ML fit: {ml_worst}");
+
+    let problem = FitProblem::new(extent, shape, &rays).unwrap();
+    assert_eq!(problem.prior_path_density(), PRIOR_PATH_DENSITY);
+    let (map, _) = fit(&problem, init.coefficients(), &FitConfig::default()).unwrap();
+    let map_worst = worst(&|r| map.ray_log_likelihood(r));
+    assert!(map_worst > grid_worst - 40.0, "with the prior: {map_worst}");
+    let max_rate = map
+        .rates_on_lattice(160, 160)
+        .into_iter()
+        .fold(0.0, f64::max);
+    assert!(max_rate < 1e3, "max λ {max_rate}");
+    // The data are still fitted: the wall stands out from the free space in front of it.
+    assert!(map.rate_at([6.05, 4.0]) > 100.0 * map.rate_at([4.5, 4.0]));
+    assert!(map.log_likelihood(&rays) > init.log_likelihood(&rays));
 }
