@@ -17,6 +17,26 @@ pub fn no(why: &str) -> String {
 }
 
 /// The last cell of a markdown table line, trimmed (tests: is it the "comparable" column?).
+/// How our logs overlap a thesis' list: how many of ours it used, its logs we lack, and
+/// ours it did not use.
+pub fn log_overlap<'a>(
+    ours: &[&'a str],
+    thesis: &[&'a str],
+) -> (usize, Vec<&'a str>, Vec<&'a str>) {
+    let shared = ours.iter().filter(|l| thesis.contains(l)).count();
+    let absent = thesis
+        .iter()
+        .filter(|t| !ours.contains(t))
+        .copied()
+        .collect();
+    let extra = ours
+        .iter()
+        .filter(|l| !thesis.contains(l))
+        .copied()
+        .collect();
+    (shared, absent, extra)
+}
+
 #[cfg(test)]
 pub fn last_cell(line: &str) -> &str {
     line.trim_end()

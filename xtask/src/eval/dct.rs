@@ -81,17 +81,7 @@ const THESIS_LOGS: [&str; 12] = [
 /// Our logs beside the thesis' 12 (for the "comparable" cells): how many of its logs, which
 /// are absent, which of ours it did not use.
 fn logs_text(logs: &[&str]) -> String {
-    let ours = logs.iter().filter(|l| THESIS_LOGS.contains(l)).count();
-    let absent: Vec<&str> = THESIS_LOGS
-        .iter()
-        .filter(|t| !logs.contains(t))
-        .copied()
-        .collect();
-    let extra: Vec<&str> = logs
-        .iter()
-        .filter(|l| !THESIS_LOGS.contains(l))
-        .copied()
-        .collect();
+    let (ours, absent, extra) = comparable::log_overlap(logs, &THESIS_LOGS);
     let mut text = format!("real Radish logs in both, {ours} of the thesis' 12");
     if !absent.is_empty() {
         text.push_str(&format!(" (absent: {})", absent.join(", ")));

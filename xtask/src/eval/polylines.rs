@@ -113,17 +113,7 @@ const THESIS_LOGS: [&str; 13] = [
 /// What our real scans are beside the thesis' (for the "comparable" cells): which of the
 /// thesis' 13 logs they come from and which are absent.
 fn real_data_text(logs: &[&str], scans: usize) -> String {
-    let ours = logs.iter().filter(|l| THESIS_LOGS.contains(l)).count();
-    let absent: Vec<&str> = THESIS_LOGS
-        .iter()
-        .filter(|t| !logs.contains(t))
-        .copied()
-        .collect();
-    let extra: Vec<&str> = logs
-        .iter()
-        .filter(|l| !THESIS_LOGS.contains(l))
-        .copied()
-        .collect();
+    let (ours, absent, extra) = comparable::log_overlap(logs, &THESIS_LOGS);
     let mut text =
         format!("{scans} real scans from {ours} of the thesis' 13 Radish logs (thesis: 260 scans)");
     if !absent.is_empty() {
