@@ -314,6 +314,47 @@ fn gt_seg_variants() {
     assert_eq!(err.location(), Location::Byte(11));
 }
 
+/// Inputs found by `cargo xtask fuzz`: errors about a cut header or cut pixels name a byte
+/// inside the file (the Sun header's words are read out of order, and the PGM reader stepped
+/// over the blank after maxval), and a pixel above maxval names its byte.
+#[test]
+fn gt_seg_errors_name_a_byte_inside_the_file() {
+    let sun = sun_raster(1, 3, &[vec![0u8, 10, 10], vec![11, 11, 255]]);
+    // Cut after six of the header's eight words (fuzz case 510; was byte 28 of 24).
+    let err = parse_gt_seg(&sun[..24], "s").unwrap_err();
+    assert_eq!(err.location(), Location::Byte(24), "{err}");
+    assert!(err.to_string().contains("Sun rasterfile header"), "{err}");
+    // Cut inside the fifth word (was byte 20 of 19).
+    let err = parse_gt_seg(&sun[..19], "s").unwrap_err();
+    assert_eq!(err.location(), Location::Byte(16), "{err}");
+    // A binary PGM that ends right after its maxval (fuzz case 513; was byte 19 of 18).
+    let err = parse_gt_seg(b"P5\n#-1\x00308 c\n3 2\n3", "p").unwrap_err();
+    assert_eq!(err.location(), Location::Byte(18), "{err}");
+    assert!(err.to_string().contains("3 × 2 PGM pixels"), "{err}");
+    // Pixels above maxval (binary, text): their byte, not the whole file.
+    let err = parse_gt_seg(b"P5 2 1 10\n\x05\x0b", "p").unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "p: byte 11: pixel 1 exceeds maxval 10",
+        "{err}"
+    );
+    let err = parse_gt_seg(b"P2 2 1 10\n5 11\n", "p").unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "p: byte 12: pixel 1 exceeds maxval 10",
+        "{err}"
+    );
+    // Perceptron-layout files that end with header line 10 (fuzz cases 1058 of gt-seg and
+    // 4066 of range; were one byte beyond the end): the end of the file.
+    let mut head = b"2 rows\n3 columns\n".to_vec();
+    head.extend(b"x\n".repeat(8));
+    let err = parse_gt_seg(&head, "r").unwrap_err();
+    assert_eq!(err.location(), Location::Byte(head.len() as u64), "{err}");
+    let err = parse_range_image(&head, "perc.test.1").unwrap_err();
+    assert_eq!(err.location(), Location::Byte(head.len() as u64), "{err}");
+    assert!(err.to_string().contains("0 present"), "{err}");
+}
+
 #[test]
 fn gt_ang_parses_and_checks() {
     let text = "3\n10 11 90\n11 12 45\n\n10 12 135\n";

@@ -131,9 +131,11 @@ fn parse_sun_raster(bytes: &[u8], path: &Path) -> Result<GroundTruthSegmentation
             .and_then(|b| b.try_into().ok())
             .map(u32::from_be_bytes)
             .ok_or_else(|| {
+                // The fields are read out of order: name the first incomplete word.
+                let first_missing = (4 * k).min(bytes.len() / 4 * 4);
                 Error::truncated(
                     path,
-                    Location::Byte(4 * k as u64),
+                    Location::Byte(first_missing as u64),
                     "the Sun rasterfile header",
                 )
             })
@@ -256,37 +258,50 @@ fn parse_pgm(bytes: &[u8], path: &Path) -> Result<GroundTruthSegmentation> {
         ));
     }
     let pixels = rows * columns;
+    let too_large = |i: usize, at: usize| {
+        Error::malformed(
+            path,
+            Location::Byte(at as u64),
+            format!("pixel {i} exceeds maxval {max_value}"),
+        )
+    };
     let labels: Vec<u32> = if binary {
         pos += 1; // the single whitespace after maxval
         let bpp = if max_value < 256 { 1 } else { 2 };
         let data = bytes.get(pos..pos + pixels * bpp).ok_or_else(|| {
             Error::truncated(
                 path,
-                Location::Byte(pos as u64),
+                Location::Byte(pos.min(bytes.len()) as u64),
                 format!("{columns} × {rows} PGM pixels"),
             )
         })?;
-        if bpp == 1 {
+        let labels: Vec<u32> = if bpp == 1 {
             data.iter().map(|&b| u32::from(b)).collect()
         } else {
             data.chunks_exact(2)
                 .map(|w| u32::from(u16::from_be_bytes([w[0], w[1]])))
                 .collect()
+        };
+        if let Some(i) = labels.iter().position(|&v| v as usize > max_value) {
+            return Err(too_large(i, pos + i * bpp));
         }
+        labels
     } else {
         let mut labels = Vec::with_capacity(pixels.min(bytes.len()));
-        for _ in 0..pixels {
-            labels.push(pgm_number(bytes, &mut pos, path, "pixel")? as u32);
+        for i in 0..pixels {
+            let value = pgm_number(bytes, &mut pos, path, "pixel")?;
+            if value > max_value {
+                let digits = bytes[..pos]
+                    .iter()
+                    .rev()
+                    .take_while(|b| b.is_ascii_digit())
+                    .count();
+                return Err(too_large(i, pos - digits));
+            }
+            labels.push(value as u32);
         }
         labels
     };
-    if let Some(i) = labels.iter().position(|&v| v as usize > max_value) {
-        return Err(Error::malformed(
-            path,
-            Location::File,
-            format!("pixel {i} exceeds maxval {max_value}"),
-        ));
-    }
     Ok(GroundTruthSegmentation {
         rows,
         columns,

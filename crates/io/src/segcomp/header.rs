@@ -114,9 +114,10 @@ impl TextHeader {
         let present = total.saturating_sub(start);
         let wanted = pixels * bytes_per_pixel.first().copied().unwrap_or(1);
         Err(if present < wanted {
+            // A file that ends with line 10 has no extra line: its end is where data is missing.
             Error::truncated(
                 path,
-                Location::Byte(start as u64),
+                Location::Byte(start.min(total) as u64),
                 format!(
                     "{} × {} pixels ({wanted} bytes, {present} present)",
                     self.rows, self.columns

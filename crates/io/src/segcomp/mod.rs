@@ -42,7 +42,7 @@ mod range;
 
 use std::path::Path;
 
-pub use geometry::PerceptronGeometry;
+pub use geometry::{PerceptronBeam, PerceptronGeometry};
 pub use gt_ang::{AnglePair, GroundTruthAngles, parse_gt_ang, read_gt_ang};
 pub use gt_seg::{
     FIRST_PLANE_LABEL, GroundTruthSegmentation, RasterFormat, SUN_RASTER_MAGIC, parse_gt_seg,
