@@ -76,8 +76,11 @@ impl PpeParams {
         })
     }
 
-    /// Preset for the SegComp Perceptron scans (grids: `d` 4–40 mm); not tuned on the
-    /// real data, which is not available here.
+    /// Preset for the SegComp Perceptron scans (√e = d = 20 mm, planes of at least 10 rays);
+    /// not tuned on the real data, which is not available here. `cargo xtask eval segcomp`
+    /// uses it only without training images: otherwise it grid-searches √e and d on the
+    /// training images for the best fraction of correctly segmented planes, as Schaefer
+    /// (2020, § 11.5) did.
     pub fn segcomp() -> Self {
         Self {
             max_increment_m2: 0.02 * 0.02,

@@ -21,6 +21,7 @@
 //! | [`indoor`] | floor plans, doors, glass, clutter; a robot path | 2-D laser, odometry drift, intensities | corrected + raw CARMEN logs | Schaefer ch. 9–10, Khan ch. 3 |
 //! | [`corridor`] | 1-D corridor of 100 voxels | Bernoulli / exponential beams | JSON + CSV | Schaefer ch. 8 |
 //! | [`synpeb`] | rooms of polyhedral objects | organized 500 × 500, σ 1 mdeg, 0–4 cm | PCD, label in `intensity` | Schaefer ch. 11 |
+//! | [`segcomp`] | blocks, wedges, prisms on a table (SegComp-like) | Perceptron 512 × 512, σ 1 mm / cos θ, mixed pixels, calibration kink | in memory (SegComp range image, labels, angles) | Schaefer ch. 11 |
 //! | [`urban`] | streets, facades, poles, trees, cars; sessions with changes | HDL-64E / HDL-32E ([`lidar3`]) | KITTI / NCLT layouts + poles | Schaefer ch. 12 |
 //! | [`semi_kitti`] | streets around a real KITTI drive and pole map | HDL-64E | KITTI layout + poles | Schaefer ch. 12 |
 //! | [`semi_nclt`] | a campus around the real NCLT pole layout and path; sessions with changes | HDL-32E | in memory (scans on demand) | Schaefer ch. 12 |
@@ -61,6 +62,7 @@ pub mod polygons;
 pub mod rng;
 pub mod scene2;
 pub mod scene3;
+pub mod segcomp;
 pub mod semi_kitti;
 pub mod semi_nclt;
 pub mod synpeb;

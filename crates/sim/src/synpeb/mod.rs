@@ -64,6 +64,8 @@ use raypath_io::pcd::{self, DataEncoding, ReadOptions, WriteOptions};
 use serde_json::json;
 
 pub use objects::{FIRST_PLANE_LABEL, LABEL_CYLINDER, LABEL_SPHERE};
+pub(crate) use objects::{Kind, Labeler, Shape, random_polygon};
+pub(crate) use room::{Footprint, floor_pose};
 pub use room::{SynpebRoom, build_room};
 pub use stats::{MIN_PLANE_LABEL, ScanStats, crop, scan_stats};
 

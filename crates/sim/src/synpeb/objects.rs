@@ -28,7 +28,7 @@ pub const FIRST_PLANE_LABEL: u32 = 10;
 const CYLINDER_SEGMENTS: usize = 48;
 
 /// Hands out surfaces: a new plane label for every planar face.
-pub(super) struct Labeler {
+pub(crate) struct Labeler {
     pub builder: SceneBuilder3,
     next_label: u32,
 }
@@ -75,7 +75,7 @@ impl Labeler {
 
 /// A shape and its dimensions (metres).
 #[derive(Clone, Debug)]
-pub(super) enum Shape {
+pub(crate) enum Shape {
     Cuboid(Vector3<f64>),
     Wedge(Vector3<f64>),
     Prism {
@@ -123,7 +123,7 @@ pub(super) enum Shape {
 
 /// Which shape to draw.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Kind {
+pub(crate) enum Kind {
     Cuboid,
     Wedge,
     Prism,
@@ -183,7 +183,7 @@ pub(super) fn kind_mix(n: usize, rng: &mut SimRng) -> Vec<Kind> {
 
 /// A convex polygon of `n` vertices around the origin with radii jittered by ±15 % (the
 /// regular polygon when the jitter breaks convexity).
-fn random_polygon(rng: &mut SimRng, n: usize, radius: f64) -> Vec<Point2<f64>> {
+pub(crate) fn random_polygon(rng: &mut SimRng, n: usize, radius: f64) -> Vec<Point2<f64>> {
     let phase = rng.random_range(0.0..TAU);
     let jittered: Vec<Point2<f64>> = (0..n)
         .map(|i| {
@@ -282,6 +282,68 @@ impl Shape {
             Kind::Cabinet => Shape::Cabinet {
                 size: Vector3::new(u(0.3, 0.45), u(0.5, 1.2), u(0.4, 0.8)),
                 mount: rng.random_range(1.2..1.8),
+            },
+        }
+    }
+
+    /// The same shape with every length multiplied by `factor` (angles, step and shelf
+    /// counts kept): room furniture shrunk to table-top blocks.
+    pub fn scaled(&self, factor: f64) -> Self {
+        let k = factor;
+        match self {
+            Shape::Cuboid(s) => Shape::Cuboid(s * k),
+            Shape::Wedge(s) => Shape::Wedge(s * k),
+            Shape::Prism { base, height } => Shape::Prism {
+                base: base.iter().map(|p| Point2::from(p.coords * k)).collect(),
+                height: height * k,
+            },
+            Shape::Stairs {
+                steps,
+                depth,
+                rise,
+                width,
+            } => Shape::Stairs {
+                steps: *steps,
+                depth: depth * k,
+                rise: rise * k,
+                width: width * k,
+            },
+            Shape::Table {
+                size,
+                height,
+                top,
+                leg,
+            } => Shape::Table {
+                size: size * k,
+                height: height * k,
+                top: top * k,
+                leg: leg * k,
+            },
+            Shape::Shelf {
+                depth,
+                width,
+                height,
+                board,
+                shelves,
+            } => Shape::Shelf {
+                depth: depth * k,
+                width: width * k,
+                height: height * k,
+                board: board * k,
+                shelves: *shelves,
+            },
+            Shape::Tumbled { inner, rotation } => Shape::Tumbled {
+                inner: Box::new(inner.scaled(k)),
+                rotation: *rotation,
+            },
+            Shape::Cylinder { radius, height } => Shape::Cylinder {
+                radius: radius * k,
+                height: height * k,
+            },
+            Shape::Sphere { radius } => Shape::Sphere { radius: radius * k },
+            Shape::Cabinet { size, mount } => Shape::Cabinet {
+                size: size * k,
+                mount: mount * k,
             },
         }
     }

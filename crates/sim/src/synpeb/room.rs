@@ -36,10 +36,10 @@ const ATTEMPTS: usize = 40;
 
 /// An oriented rectangle on the floor.
 #[derive(Clone, Copy, Debug)]
-struct Footprint {
-    center: Point2<f64>,
-    yaw: f64,
-    half: Vector2<f64>,
+pub(crate) struct Footprint {
+    pub(crate) center: Point2<f64>,
+    pub(crate) yaw: f64,
+    pub(crate) half: Vector2<f64>,
 }
 
 impl Footprint {
@@ -49,13 +49,13 @@ impl Footprint {
     }
 
     /// Half width of the rectangle projected on the unit `axis`.
-    fn radius_along(&self, axis: &Vector2<f64>) -> f64 {
+    pub(crate) fn radius_along(&self, axis: &Vector2<f64>) -> f64 {
         let [u, v] = self.axes();
         self.half.x * u.dot(axis).abs() + self.half.y * v.dot(axis).abs()
     }
 
     /// Separating-axis test with a gap of `margin`.
-    fn overlaps(&self, other: &Footprint, margin: f64) -> bool {
+    pub(crate) fn overlaps(&self, other: &Footprint, margin: f64) -> bool {
         let d = other.center - self.center;
         self.axes().iter().chain(other.axes().iter()).all(|axis| {
             d.dot(axis).abs() < self.radius_along(axis) + other.radius_along(axis) + margin
@@ -227,7 +227,7 @@ fn add_shell(labels: &mut Labeler, size: &Vector3<f64>) {
     }
 }
 
-fn floor_pose(footprint: &Footprint, z: f64) -> Pose3 {
+pub(crate) fn floor_pose(footprint: &Footprint, z: f64) -> Pose3 {
     Pose3::from_xyz_rpy(
         footprint.center.x,
         footprint.center.y,
