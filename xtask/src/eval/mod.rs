@@ -13,6 +13,7 @@ mod io;
 mod mcl;
 mod octomap;
 mod place_recognition;
+mod planes;
 mod poles_kitti;
 mod poles_nclt;
 mod polylines;
@@ -155,7 +156,7 @@ const EVALUATIONS: &[(&str, &str, EvalFn)] = &[
     ),
     (
         "segcomp",
-        "PPE on the SegComp Perceptron scans when installed (Table 11.1); else how to get them",
+        "PPE, PEAC-style and MSAC grid-searched on SegComp Perceptron (when installed) and a simulated stand-in (Table 11.1)",
         segcomp::run,
     ),
     (

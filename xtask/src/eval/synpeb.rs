@@ -10,14 +10,12 @@
 //! RMSE exceeds 20 mm from the mean).
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use anyhow::{Context, Result};
 use raypath_io::pcd::{ReadOptions, read_pcd};
-use raypath_planes::{
-    HooverParams, MsacParams, PeacParams, PpeParams, compare, extract, msac, peac,
-};
+use raypath_planes::{MsacParams, PeacParams, PpeParams};
 
+use super::planes::{HooverScore as Scan, Method, hoover_score, mean};
 use super::{EvalContext, EvalReport, median};
 use crate::table::{Table, fmt_num};
 
@@ -26,56 +24,11 @@ mod real;
 const NAME: &str = "synpeb";
 const LEVELS: [&str; 5] = ["0.0", "0.5", "1.0", "2.0", "4.0"];
 
-#[derive(Default, Clone)]
-struct Scan {
-    f: f64,
-    k: f64,
-    rmse_mm: f64,
-    n_o: f64,
-    n_u: f64,
-    n_m: f64,
-    n_s: f64,
-    gt: f64,
-    planes: f64,
-    secs: f64,
-}
-
-#[derive(Clone, Copy)]
-enum Method {
-    Ppe(PpeParams),
-    Msac(MsacParams),
-    Peac(PeacParams),
-}
-
 fn run_scan(path: &Path, method: Method) -> Result<Scan> {
     let pcd = read_pcd(path, &ReadOptions::synpeb())
         .with_context(|| format!("reading {}", path.display()))?;
     let cloud = pcd.cloud;
-    let started = Instant::now();
-    let seg = match method {
-        Method::Ppe(params) => {
-            extract(&cloud, &params).with_context(|| format!("PPE on {}", path.display()))?
-        }
-        Method::Msac(params) => {
-            let points: Vec<nalgebra::Vector3<f64>> = cloud
-                .points
-                .iter()
-                .map(|p| p.coords.cast::<f64>())
-                .collect();
-            msac(&points, cloud.width, cloud.height, &params)
-                .with_context(|| format!("MSAC on {}", path.display()))?
-        }
-        Method::Peac(params) => {
-            let points: Vec<nalgebra::Vector3<f64>> = cloud
-                .points
-                .iter()
-                .map(|p| p.coords.cast::<f64>())
-                .collect();
-            peac(&points, cloud.width, cloud.height, &params)
-                .with_context(|| format!("PEAC on {}", path.display()))?
-        }
-    };
-    let secs = started.elapsed().as_secs_f64();
+    let (seg, secs) = method.run(&cloud, &path.display().to_string())?;
     let gt: Vec<Option<u32>> = cloud
         .label
         .clone()
@@ -83,38 +36,7 @@ fn run_scan(path: &Path, method: Method) -> Result<Scan> {
         .into_iter()
         .map(Some)
         .collect();
-    let h = compare(&gt, &seg.labels, &HooverParams::default())?;
-    let (mut sse, mut n) = (0.0, 0usize);
-    for p in &seg.planes {
-        if p.fit.rmse_m() < 10.0 {
-            sse += p.fit.sse;
-            n += p.fit.n;
-        }
-    }
-    Ok(Scan {
-        f: 100.0 * h.fraction_correct(),
-        k: 100.0 * h.k_value(),
-        rmse_mm: if n == 0 {
-            f64::NAN
-        } else {
-            1000.0 * (sse / n as f64).sqrt()
-        },
-        n_o: h.over as f64,
-        n_u: h.under as f64,
-        n_m: h.missed as f64,
-        n_s: h.noise as f64,
-        gt: h.gt_regions as f64,
-        planes: seg.planes.len() as f64,
-        secs,
-    })
-}
-
-fn mean(scans: &[Scan], f: impl Fn(&Scan) -> f64) -> f64 {
-    if scans.is_empty() {
-        f64::NAN
-    } else {
-        scans.iter().map(f).sum::<f64>() / scans.len() as f64
-    }
+    hoover_score(&gt, &seg, secs, None)
 }
 
 fn pcd_files(dir: &Path) -> Vec<PathBuf> {

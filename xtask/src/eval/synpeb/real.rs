@@ -91,7 +91,7 @@ fn run_methods(
         methods().into_iter().map(|m| (m, Vec::new())).collect();
     for frame in frames {
         for (method, scores) in &mut out {
-            let (seg, secs) = method.run(frame)?;
+            let (seg, secs) = method.run(&frame.cloud, &frame.name)?;
             scores.push(score::score(frame, &seg, secs));
         }
         bar.inc(1);

@@ -2,13 +2,13 @@
 //! F1 of planar recall and lenient plane precision ([`Pooled::f1`]).
 
 use anyhow::Result;
-use raypath_planes::{MsacParams, PeacParams, PpeParams};
 use serde_json::{Value, json};
 
 use super::data::Frame;
 use super::pct;
 use super::score::{Method, Pooled, score};
 use crate::eval::EvalContext;
+use crate::eval::planes::{msac_grid, peac_grid, ppe_grid};
 use crate::table::{Table, fmt_num};
 
 /// Cells shown per method (the best by F1).
@@ -17,9 +17,9 @@ pub const SHOWN: usize = 5;
 /// The grids the full run recomputes on the tuning frames (they contain the chosen cells).
 fn grids() -> [Vec<(Method, String)>; 3] {
     [
-        ppe(&[0.10, 0.15, 0.20, 0.25], &[2.0, 4.0], &[30, 50, 100]),
-        peac(&[3, 4], &[0.03, 0.04, 0.05], &[0.15, 0.30], &[50, 100, 200]),
-        msac(&[0.05, 0.10, 0.20], &[0.1, 0.2, 0.3], &[10]),
+        ppe_grid(&[0.10, 0.15, 0.20, 0.25], &[2.0, 4.0], &[30, 50, 100], 3),
+        peac_grid(&[3, 4], &[0.03, 0.04, 0.05], &[0.15, 0.30], &[50, 100, 200]),
+        msac_grid(&[0.05, 0.10, 0.20], &[0.1, 0.2, 0.3], &[10]),
     ]
 }
 
@@ -111,7 +111,7 @@ pub fn evaluate(frames: &[Frame], methods: Vec<(Method, String)>) -> Result<Vec<
     for (method, label) in methods {
         let mut scores = Vec::new();
         for frame in frames {
-            let (seg, secs) = method.run(frame)?;
+            let (seg, secs) = method.run(&frame.cloud, &frame.name)?;
             scores.push(score(frame, &seg, secs));
         }
         cells.push(Cell {
@@ -121,78 +121,4 @@ pub fn evaluate(frames: &[Frame], methods: Vec<(Method, String)>) -> Result<Vec<
         });
     }
     Ok(cells)
-}
-
-/// The PPE grid: `√e` × `d = l_max` × minimum plane size, 3 refinement rounds.
-pub fn ppe(sqrt_e: &[f64], l_max: &[f64], min_points: &[usize]) -> Vec<(Method, String)> {
-    let mut out = Vec::new();
-    for &e in sqrt_e {
-        for &d in l_max {
-            for &m in min_points {
-                let params = PpeParams {
-                    max_increment_m2: e * e,
-                    l_max_m: d,
-                    min_points: m,
-                    refine_rounds: 3,
-                    max_planes: None,
-                };
-                out.push((Method::Ppe(params), format!("√e {e:.2}, d {d:.1}, min {m}")));
-            }
-        }
-    }
-    out
-}
-
-/// The PEAC-style grid: block size × constant tolerance (merge = 1.5 × init) ×
-/// discontinuity × minimum plane size.
-pub fn peac(
-    blocks: &[usize],
-    tol: &[f64],
-    disc: &[f64],
-    min_points: &[usize],
-) -> Vec<(Method, String)> {
-    let mut out = Vec::new();
-    for &b in blocks {
-        for &t in tol {
-            for &j in disc {
-                for &m in min_points {
-                    let params = PeacParams {
-                        block_size: b,
-                        init_tol_m: t,
-                        merge_tol_m: 1.5 * t,
-                        discontinuity_rel: j,
-                        min_points: m,
-                        ..PeacParams::synpeb()
-                    };
-                    out.push((
-                        Method::Peac(params),
-                        format!("block {b}, tol {t:.2}, disc {j:.2}, min {m}"),
-                    ));
-                }
-            }
-        }
-    }
-    out
-}
-
-/// The MSAC grid: inlier distance × remaining fraction × minimum plane size.
-pub fn msac(dist: &[f64], remaining: &[f64], min_points: &[usize]) -> Vec<(Method, String)> {
-    let mut out = Vec::new();
-    for &d in dist {
-        for &r in remaining {
-            for &m in min_points {
-                let params = MsacParams {
-                    max_distance_m: d,
-                    remaining_fraction: r,
-                    min_points: m,
-                    ..MsacParams::synpeb()
-                };
-                out.push((
-                    Method::Msac(params),
-                    format!("dist {d:.2}, remaining {r:.2}, min {m}"),
-                ));
-            }
-        }
-    }
-    out
 }

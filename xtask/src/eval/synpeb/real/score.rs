@@ -2,11 +2,10 @@
 //! SemanticKITTI classes: planar recall, plane precision, class purity, RMSE, time.
 
 use std::collections::{BTreeMap, HashMap};
-use std::time::Instant;
 
-use anyhow::{Context, Result};
-use nalgebra::Vector3;
-use raypath_planes::{MsacParams, PeacParams, PpeParams, Segmentation, extract, msac, peac};
+use raypath_planes::Segmentation;
+
+pub use crate::eval::planes::Method;
 
 use super::data::Frame;
 
@@ -18,49 +17,6 @@ pub const PLANAR: [u16; 5] = [40, 44, 48, 50, 60];
 /// 81): a plane on them is not counted against the lenient precision, and they are left
 /// out of the recall.
 pub const PLANAR_ISH: [u16; 3] = [49, 51, 81];
-
-/// An extractor with its parameters.
-#[derive(Clone, Copy, PartialEq)]
-pub enum Method {
-    /// PPE, `raypath_planes::extract`.
-    Ppe(PpeParams),
-    /// The PEAC-style baseline.
-    Peac(PeacParams),
-    /// Iterative MSAC.
-    Msac(MsacParams),
-}
-
-impl Method {
-    /// The name in the tables.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Method::Ppe(_) => "PPE",
-            Method::Peac(_) => "PEAC-style",
-            Method::Msac(_) => "MSAC",
-        }
-    }
-
-    /// Segments `frame` and returns the segmentation and the extraction time (the
-    /// conversion to the extractor's input included, as in the SynPEB table).
-    pub fn run(&self, frame: &Frame) -> Result<(Segmentation, f64)> {
-        let cloud = &frame.cloud;
-        let started = Instant::now();
-        let points = || -> Vec<Vector3<f64>> {
-            cloud
-                .points
-                .iter()
-                .map(|p| p.coords.cast::<f64>())
-                .collect()
-        };
-        let seg = match self {
-            Method::Ppe(p) => extract(cloud, p),
-            Method::Peac(p) => peac(&points(), cloud.width, cloud.height, p),
-            Method::Msac(p) => msac(&points(), cloud.width, cloud.height, p),
-        }
-        .with_context(|| format!("{} on {}", self.name(), frame.name))?;
-        Ok((seg, started.elapsed().as_secs_f64()))
-    }
-}
 
 /// Counts of one segmented frame; sums over frames give pooled ratios.
 #[derive(Clone, Debug, Default)]
