@@ -1,4 +1,4 @@
-//! `cargo xtask`: raypath's evaluations and dataset checks.
+//! `cargo xtask`: raypath's evaluations, dataset checks and the fuzz run of the file readers.
 //!
 //! ```text
 //! cargo xtask eval <name>|all [--quick]   run evaluations, print tables, write docs/results/
@@ -6,10 +6,15 @@
 //! cargo xtask datasets                    what RAYPATH_DATA holds and what is missing
 //! cargo xtask datasets generate [--quick] [--only NAME] [--seed S]
 //!                                         write the simulated sets under datasets/generated/
+//! cargo xtask fuzz [--cases N] [--reader NAME] [--seed S] [--case K] [--list]
+//!                                         feed every raypath-io reader N mutated inputs
+//!                                         (default 100000); fail on a panic, hang or an
+//!                                         error that does not name the file and place
 //! ```
 
 mod datasets;
 mod eval;
+mod fuzz;
 mod generate;
 mod readme;
 mod render;
@@ -46,6 +51,33 @@ enum Command {
         #[command(subcommand)]
         action: Option<DatasetsAction>,
     },
+    /// Fuzz every file reader of raypath-io: mutated seed inputs (bit flips, interesting
+    /// values, truncation, chunk deletion and duplication, insertions), no panic, no hang,
+    /// and `Ok` or an error naming the file and place. Prints a table of counts; fails on a
+    /// panic, hang or bad error, saving its input to `target/fuzz/<reader>-<case>.bin`.
+    Fuzz {
+        /// Cases per reader.
+        #[arg(long, default_value_t = fuzz::DEFAULT_CASES)]
+        cases: u64,
+        /// Only these readers (comma-separated names; `--list` shows them).
+        #[arg(long, value_name = "NAME")]
+        reader: Option<String>,
+        /// Seed of the mutations (the same seed gives the same inputs).
+        #[arg(long, default_value_t = fuzz::DEFAULT_SEED)]
+        seed: u64,
+        /// Replay one case of one reader, printing its panic (if any) as usual.
+        #[arg(long, value_name = "K")]
+        case: Option<u64>,
+        /// A case running longer than this many seconds is a hang.
+        #[arg(long, default_value_t = 10)]
+        timeout_secs: u64,
+        /// List the readers, their seed counts and entry points.
+        #[arg(long)]
+        list: bool,
+        /// Internal: the child process of one reader, from this case on.
+        #[arg(long, hide = true)]
+        child_first: Option<u64>,
+    },
 }
 
 #[derive(Subcommand)]
@@ -74,5 +106,22 @@ fn main() -> Result<()> {
                 generate::run(quick, only.as_deref(), seed)
             }
         },
+        Command::Fuzz {
+            cases,
+            reader,
+            seed,
+            case,
+            timeout_secs,
+            list,
+            child_first,
+        } => fuzz::run(&fuzz::FuzzOptions {
+            cases,
+            reader,
+            seed,
+            case,
+            timeout_secs,
+            list,
+            child_first,
+        }),
     }
 }
