@@ -55,29 +55,7 @@ enum Command {
     /// values, truncation, chunk deletion and duplication, insertions), no panic, no hang,
     /// and `Ok` or an error naming the file and place. Prints a table of counts; fails on a
     /// panic, hang or bad error, saving its input to `target/fuzz/<reader>-<case>.bin`.
-    Fuzz {
-        /// Cases per reader.
-        #[arg(long, default_value_t = fuzz::DEFAULT_CASES)]
-        cases: u64,
-        /// Only these readers (comma-separated names; `--list` shows them).
-        #[arg(long, value_name = "NAME")]
-        reader: Option<String>,
-        /// Seed of the mutations (the same seed gives the same inputs).
-        #[arg(long, default_value_t = fuzz::DEFAULT_SEED)]
-        seed: u64,
-        /// Replay one case of one reader, printing its panic (if any) as usual.
-        #[arg(long, value_name = "K")]
-        case: Option<u64>,
-        /// A case running longer than this many seconds is a hang.
-        #[arg(long, default_value_t = 10)]
-        timeout_secs: u64,
-        /// List the readers, their seed counts and entry points.
-        #[arg(long)]
-        list: bool,
-        /// Internal: the child process of one reader, from this case on.
-        #[arg(long, hide = true)]
-        child_first: Option<u64>,
-    },
+    Fuzz(fuzz::FuzzOptions),
 }
 
 #[derive(Subcommand)]
@@ -106,22 +84,6 @@ fn main() -> Result<()> {
                 generate::run(quick, only.as_deref(), seed)
             }
         },
-        Command::Fuzz {
-            cases,
-            reader,
-            seed,
-            case,
-            timeout_secs,
-            list,
-            child_first,
-        } => fuzz::run(&fuzz::FuzzOptions {
-            cases,
-            reader,
-            seed,
-            case,
-            timeout_secs,
-            list,
-            child_first,
-        }),
+        Command::Fuzz(options) => fuzz::run(&options),
     }
 }

@@ -66,6 +66,7 @@ pub mod pcd;
 pub mod point_csv;
 pub mod poles_csv;
 pub mod rosbag;
+pub mod samples;
 pub mod segcomp;
 pub mod sequence;
 pub mod source;

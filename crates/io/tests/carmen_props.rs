@@ -7,20 +7,7 @@ use std::io::Cursor;
 
 use proptest::prelude::*;
 use raypath_io::carmen::{CarmenConfig, CarmenReader, Record};
-
-const LOG: &str = "\
-# CARMEN Logfile
-PARAM laser_front_laser_resolution 1 0.0 nohost 0
-PARAM robot_front_laser_max 30.5 1000.0 host 0.001
-PARAM laser_front_laser_flipped 0 nohost 0
-ODOM 1.0 2.0 0.5 0.3 -0.1 0.0 1000.25 host 0.25
-FLASER 4 1.0 2.0 81.91 4.0 10.0 20.0 1.57 10.5 20.5 1.6 1000.5 robby 0.5
-FLASER 4 1.5 81.91 3.0 4.5 10.1 20.0 1.57 10.6 20.5 1.6 1000.6 robby 0.6
-RLASER 3 1.0 31.0 2.0 0.0 0.0 0.0 0.0 0.0 0.0 1000.6 robby 0.6
-NEFF 27.6 0 pippo 0
-ROBOTLASER1 0 -1.0 2.0 1.0 81.9 0.01 1 3 5.0 81.91 6.0 3 100 200 300 1.0 0.0 0.0 0.8 0.0 0.0 0.25 0.1 0.5 0.3 0.2 1000.75 robby 0.75
-TRUEPOS 1 2 3 4 5 6 7 h 8
-";
+use raypath_io::samples::CARMEN_LOG as LOG;
 
 /// Tokens that stress number parsing and counts.
 const NASTY: [&str; 12] = [

@@ -138,43 +138,9 @@ proptest! {
     }
 }
 
+/// One CDR message of each type (`raypath_io::samples::rosbag_cdr`).
 fn sample_message(which: usize) -> Vec<u8> {
-    let mut w = rosbag::cdr::CdrWriter::new();
-    let stamp = Stamp { sec: 3, nanosec: 4 };
-    let pose = Pose3::from_xyz_rpy(1.0, 2.0, 3.0, 0.1, 0.2, 0.3);
-    match which {
-        0 => rosbag::encode_scan(
-            &mut w,
-            stamp,
-            "laser",
-            &Scan2 {
-                angle_min_rad: -1.0,
-                angle_increment_rad: 0.1,
-                max_range_m: 5.0,
-                ranges: vec![1.0; 12],
-                intensities: Some(vec![2.0; 12]),
-            },
-        ),
-        1 => {
-            let mut cloud = PointCloud::from_points(vec![Point3::new(1.0, 2.0, 3.0); 8]);
-            cloud.intensity = Some(vec![1.0; 8]);
-            cloud.width = 4;
-            cloud.height = 2;
-            rosbag::encode_cloud(&mut w, stamp, "lidar", &cloud);
-        }
-        2 => rosbag::encode_odometry(&mut w, stamp, "odom", "base_link", &pose),
-        3 => rosbag::encode_tf(
-            &mut w,
-            &[Transform {
-                stamp,
-                parent: "a".into(),
-                child: "b".into(),
-                parent_from_child: pose,
-            }],
-        ),
-        _ => rosbag::encode_pose_stamped(&mut w, stamp, "map", &pose),
-    }
-    w.bytes().to_vec()
+    raypath_io::samples::rosbag_cdr().swap_remove(which).bytes
 }
 
 #[test]

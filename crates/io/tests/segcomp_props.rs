@@ -2,37 +2,22 @@
 #![allow(clippy::unwrap_used)]
 
 use proptest::prelude::*;
-use raypath_io::lzw;
 use raypath_io::segcomp::{parse_gt_ang, parse_gt_seg, parse_range_image};
+use raypath_io::{lzw, samples};
 
+/// The hand-made range image of `raypath_io::samples`.
 fn range_file() -> Vec<u8> {
-    let mut bytes = b"3 rows\n2 columns\n".to_vec();
-    bytes.extend(b"header line\n".repeat(8));
-    bytes.extend(b"\n");
-    for i in 0..6u32 {
-        bytes.extend((0x5000_0000 | (i * 500)).to_be_bytes());
-    }
-    bytes
+    samples::segcomp_range().unwrap().remove(0).bytes
 }
 
+/// The five hand-made ground-truth rasters of `raypath_io::samples`.
 fn seg_files() -> Vec<Vec<u8>> {
-    let mut sun = Vec::new();
-    for w in [0x59a6_6a95u32, 3, 2, 8, 12, 2, 1, 3] {
-        sun.extend(w.to_be_bytes());
-    }
-    sun.extend([1, 2, 3]);
-    sun.extend([0x80, 2, 10, 0, 0x80, 0, 11, 12, 0]);
-    let mut plain = Vec::new();
-    for w in [0x59a6_6a95u32, 3, 2, 8, 8, 1, 0, 0] {
-        plain.extend(w.to_be_bytes());
-    }
-    plain.extend([10, 10, 11, 0, 12, 12, 13, 0]);
-    let mut pgm = b"P5\n# c\n3 2\n300\n".to_vec();
-    pgm.extend([0, 10, 0, 11, 1, 44, 0, 12, 0, 13, 0, 14]);
-    let mut raw = b"2 rows\n3 columns\n".to_vec();
-    raw.extend(b"x\n".repeat(9));
-    raw.extend([10, 11, 12, 13, 14, 15]);
-    vec![sun, plain, pgm, b"P2 2 2 20\n1 2\n3 20\n".to_vec(), raw]
+    let files: Vec<_> = samples::segcomp_gt_seg()
+        .unwrap()
+        .into_iter()
+        .map(|s| s.bytes)
+        .collect();
+    files[..5].to_vec()
 }
 
 fn mutate(mut bytes: Vec<u8>, cut: f64, edits: &[(f64, u8)]) -> Vec<u8> {

@@ -1,9 +1,9 @@
 //! `cargo xtask fuzz`: a fuzz-style run of every file reader of `raypath-io` over mutated
 //! inputs, for a fixed budget of cases per reader.
 //!
-//! For each reader ([`targets::all`]) a few small valid seed inputs are made with the crate's
-//! own writers or by hand ([`seeds`]); each case mutates one of them ([`mutate`]: bit flips,
-//! interesting bytes and integers, truncation, chunk deletion and duplication, random and
+//! For each reader ([`targets::all`]) the seed inputs are the small valid files of
+//! [`raypath_io::samples`] (the readers' property tests start from the same ones); each case
+//! mutates one of them ([`mutate`]: bit flips, interesting bytes and integers, truncation, chunk deletion and duplication, random and
 //! token insertions, splices of two seeds) and feeds it to the reader through its in-memory
 //! entry point (a file in a scratch directory for the two readers that only open paths). The
 //! property: no panic, no hang, and either `Ok` or an error naming the file and a place in it.
@@ -33,7 +33,6 @@
 //! entry points.
 
 mod mutate;
-mod seeds;
 mod targets;
 
 use std::any::Any;
@@ -59,20 +58,28 @@ pub const DEFAULT_SEED: u64 = 20_201_126;
 const MAX_SAVED: usize = 20;
 
 /// Options of `cargo xtask fuzz`.
+#[derive(clap::Args, Debug)]
 pub struct FuzzOptions {
     /// Cases per reader.
+    #[arg(long, default_value_t = DEFAULT_CASES)]
     pub cases: u64,
-    /// Readers to run (comma-separated names); all when `None`.
+    /// Only these readers (comma-separated names; `--list` shows them).
+    #[arg(long, value_name = "NAME")]
     pub reader: Option<String>,
-    /// Seed of the inputs.
+    /// Seed of the mutations (the same seed gives the same inputs).
+    #[arg(long, default_value_t = DEFAULT_SEED)]
     pub seed: u64,
-    /// Run only this case (with `--reader`), printing what happened.
+    /// Replay one case of one reader, printing its panic (if any) as usual.
+    #[arg(long, value_name = "K")]
     pub case: Option<u64>,
-    /// A case running longer than this is a hang.
+    /// A case running longer than this many seconds is a hang.
+    #[arg(long, default_value_t = 10)]
     pub timeout_secs: u64,
-    /// List the readers and exit.
+    /// List the readers, their seed counts and entry points.
+    #[arg(long)]
     pub list: bool,
-    /// Internal: run as the child process of one reader, cases `first..first + cases`.
+    /// Internal: the child process of one reader, from this case on.
+    #[arg(long, hide = true)]
     pub child_first: Option<u64>,
 }
 

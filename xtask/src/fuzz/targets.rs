@@ -18,7 +18,7 @@ use raypath_io::{
     Error, Location, kitti, lzw, nclt, octomap, pcd, poles_csv, rosbag, segcomp, tum,
 };
 
-use super::seeds::{self, Seed};
+use raypath_io::samples::{self, Sample};
 
 /// What one case came to.
 #[derive(Clone, Debug, PartialEq)]
@@ -61,7 +61,7 @@ pub struct Target {
     /// The entry points exercised.
     pub reads: &'static str,
     /// Valid inputs to mutate.
-    pub seeds: Vec<Seed>,
+    pub seeds: Vec<Sample>,
     /// Tokens the mutator writes or inserts (format keywords added to the common ones).
     pub tokens: Vec<&'static [u8]>,
     /// True when inputs go through a file (the case gets a scratch directory).
@@ -74,7 +74,7 @@ impl Target {
     fn new(
         name: &'static str,
         reads: &'static str,
-        seeds: Vec<Seed>,
+        seeds: Vec<Sample>,
         tokens: &[&'static [u8]],
         read: impl Fn(&Input<'_>) -> Verdict + Send + Sync + 'static,
     ) -> Self {
@@ -345,7 +345,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "carmen",
             "carmen::CarmenReader::with_config (look-ahead, fan, no-return and strictness varied)",
-            seeds::carmen()?,
+            samples::carmen()?,
             CARMEN_TOKENS,
             |input| {
                 let v = input.variant;
@@ -380,7 +380,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "kitti-velodyne",
             "kitti::parse_velodyne",
-            seeds::kitti_velodyne()?,
+            samples::kitti_velodyne()?,
             &[],
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -393,7 +393,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "kitti-labels",
             "kitti::parse_labels, count_classes",
-            seeds::kitti_labels(),
+            samples::kitti_labels(),
             &[],
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -406,7 +406,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "kitti-poses",
             "kitti::parse_poses",
-            seeds::kitti_poses()?,
+            samples::kitti_poses()?,
             KITTI_TOKENS,
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -417,7 +417,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "kitti-times",
             "kitti::parse_times",
-            seeds::kitti_times()?,
+            samples::kitti_times()?,
             KITTI_TOKENS,
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -428,7 +428,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "kitti-calib",
             "kitti::parse_calib, cam0_from_velo, projection",
-            seeds::kitti_calib()?,
+            samples::kitti_calib()?,
             KITTI_TOKENS,
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -444,7 +444,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "nclt-sync",
             "nclt::parse_velodyne_sync",
-            seeds::nclt_sync()?,
+            samples::nclt_sync()?,
             &[],
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -459,7 +459,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "nclt-hits",
             "nclt::HitsReader (packets or headers only; length known or not)",
-            seeds::nclt_hits(),
+            samples::nclt_hits(),
             &[],
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -481,7 +481,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "nclt-pose-csv",
             "nclt::parse_pose_csv, NcltPose::world_from_body",
-            seeds::nclt_pose_csv()?,
+            samples::nclt_pose_csv()?,
             CSV_TOKENS,
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -497,7 +497,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "nclt-covariance",
             "nclt::parse_covariance",
-            seeds::nclt_covariance()?,
+            samples::nclt_covariance()?,
             CSV_TOKENS,
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -508,7 +508,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "octomap-bt",
             "octomap::parse_bt (BtReader), OcTree::bounding_box",
-            seeds::octomap_bt()?,
+            samples::octomap_bt()?,
             OCTOMAP_TOKENS,
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -521,7 +521,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "octomap-graph",
             "octomap::parse_graph, ScanGraphReader (node by node, read_edges)",
-            seeds::octomap_graph()?,
+            samples::octomap_graph()?,
             &[],
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -552,7 +552,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "pcd",
             "pcd::read_pcd_bytes (every label source)",
-            seeds::pcd()?,
+            samples::pcd()?,
             PCD_TOKENS,
             |input| {
                 let label_from = match input.variant % 4 {
@@ -573,7 +573,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "rosbag",
             "rosbag::info, rosbag::open_planar or SweepSequence::open + sweep (one a case; a file)",
-            seeds::rosbag_bags(scratch)?,
+            samples::rosbag_bags(scratch)?,
             &[],
             |input| {
                 let path = file(input);
@@ -609,7 +609,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "rosbag-cdr",
             "rosbag::decode_scan/cloud/odometry/tf/pose_stamped (each input through all five)",
-            seeds::rosbag_cdr(),
+            samples::rosbag_cdr(),
             &[],
             |input| {
                 let cdr = |r: Result<(), rosbag::cdr::CdrError>| {
@@ -640,7 +640,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "segcomp-range",
             "segcomp::parse_range_image",
-            seeds::segcomp_range()?,
+            samples::segcomp_range()?,
             SEGCOMP_TOKENS,
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -651,7 +651,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "segcomp-gt-seg",
             "segcomp::parse_gt_seg (Sun raster, PGM, raw), labels",
-            seeds::segcomp_gt_seg()?,
+            samples::segcomp_gt_seg()?,
             SEGCOMP_TOKENS,
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -664,7 +664,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "segcomp-gt-ang",
             "segcomp::parse_gt_ang",
-            seeds::segcomp_gt_ang(),
+            samples::segcomp_gt_ang(),
             SEGCOMP_TOKENS,
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -675,7 +675,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "lzw",
             "lzw::decompress (Unix compress .Z)",
-            seeds::lzw(),
+            samples::lzw(),
             &[
                 b"\x1f\x9d\x90",
                 b"\x1f\x9d\x10",
@@ -693,7 +693,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "point-csv",
             "point_csv::PointCsv::parse, PointCsvReader::next_row",
-            seeds::point_csv(),
+            samples::point_csv(),
             CSV_TOKENS,
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -712,7 +712,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "poles-csv",
             "poles_csv::parse_pole_csv",
-            seeds::poles_csv()?,
+            samples::poles_csv()?,
             CSV_TOKENS,
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -720,7 +720,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
                 check.verdict()
             },
         ),
-        Target::new("tum", "tum::parse_tum", seeds::tum(), &[], |input| {
+        Target::new("tum", "tum::parse_tum", samples::tum(), &[], |input| {
             let mut check = Check::new(input, input.name, true);
             check.ok(tum::parse_tum(cursor(input), input.name));
             check.verdict()
@@ -728,7 +728,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "xyz",
             "xyz::read_xyz_from, XyzReader::next_chunk",
-            seeds::xyz(),
+            samples::xyz(),
             &[],
             |input| {
                 let mut check = Check::new(input, input.name, true);
@@ -749,7 +749,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "rosbag-metadata",
             "rosbag::Metadata::parse (metadata.yaml)",
-            seeds::rosbag_metadata(),
+            samples::rosbag_metadata(),
             YAML_TOKENS,
             |input| {
                 let _ = rosbag::Metadata::parse(&String::from_utf8_lossy(input.bytes));
@@ -759,7 +759,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
         Target::new(
             "summarize",
             "Format::detect + summarize of a file (every single-file format; gzip, bzip2, .Z)",
-            seeds::summarize()?,
+            samples::named_files()?,
             CARMEN_TOKENS,
             |input| {
                 let path = file(input);
@@ -807,18 +807,18 @@ const ORDER: [&str; 27] = [
 
 /// Ouster captures, each read with the metadata it was made for.
 fn ouster_pcap() -> Result<Target> {
-    let sensors = seeds::ouster_sensors();
+    let sensors = samples::ouster_sensors();
     let mut infos = Vec::new();
     let mut captures = Vec::new();
     for (k, sensor) in sensors.iter().enumerate() {
         let info = SensorInfo::parse(sensor.json.as_bytes(), format!("sensor-{k}.json"))?;
         let name = match sensor.capture {
-            seeds::Capture::Pcapng => "fuzz.pcapng",
+            samples::Capture::Pcapng => "fuzz.pcapng",
             _ => "fuzz.pcap",
         };
-        captures.push(Seed::new(
+        captures.push(Sample::new(
             name,
-            seeds::ouster_capture(&info, sensor.capture),
+            samples::ouster_capture(&info, sensor.capture),
         ));
         let lut = XyzLut::new(&info)?;
         infos.push((info, lut));
@@ -856,13 +856,13 @@ fn ouster_pcap() -> Result<Target> {
 
 /// Ouster metadata; what parses reads the capture made for the seed's sensor.
 fn ouster_json() -> Result<Target> {
-    let sensors = seeds::ouster_sensors();
+    let sensors = samples::ouster_sensors();
     let mut jsons = Vec::new();
     let mut captures = Vec::new();
     for (k, sensor) in sensors.iter().enumerate() {
         let info = SensorInfo::parse(sensor.json.as_bytes(), format!("sensor-{k}.json"))?;
-        captures.push(seeds::ouster_capture(&info, sensor.capture));
-        jsons.push(Seed::new("fuzz.json", sensor.json.clone()));
+        captures.push(samples::ouster_capture(&info, sensor.capture));
+        jsons.push(Sample::new("fuzz.json", sensor.json.clone()));
     }
     Ok(Target::new(
         "ouster-json",

@@ -11,6 +11,8 @@ use serde_json::{Value, json};
 
 use super::packet::{PacketLayout, Pixel, decode_pixel};
 use super::*;
+use crate::samples::ouster::{put16, put32, write_packet_header};
+use crate::samples::{classic_pcap as classic, ip_frames, pcapng, udp_datagram, udp_frames};
 
 /// Nested (firmware 3.x) metadata of a small sensor: `w` columns, `h` beams, `cpp` columns
 /// per packet, altitudes 10° down to −10°, no beam azimuth offsets.
@@ -43,14 +45,6 @@ fn info_of(value: &Value) -> SensorInfo {
 
 fn small(profile: &str) -> SensorInfo {
     info_of(&nested(profile, 8, 4, 4, &[3, 2, 1, 0]))
-}
-
-fn put16(b: &mut [u8], at: usize, v: u16) {
-    b[at..at + 2].copy_from_slice(&v.to_le_bytes());
-}
-
-fn put32(b: &mut [u8], at: usize, v: u32) {
-    b[at..at + 4].copy_from_slice(&v.to_le_bytes());
 }
 
 /// The bytes of one pixel in `profile` (the encoder the decoder is tested against).
@@ -124,22 +118,7 @@ fn packet(info: &SensorInfo, f: u32, first: usize, invalid: Option<usize>) -> Ve
     let layout = PacketLayout::new(info);
     let legacy = info.profile == LidarProfile::Legacy;
     let mut b = vec![0u8; layout.packet_bytes];
-    let serial: u64 = info.serial.parse().unwrap_or(0);
-    let init_id = info.init_id.unwrap_or(0);
-    match (legacy, info.header_type) {
-        (true, _) => {}
-        (false, HeaderType::Standard) => {
-            put16(&mut b, 0, 1);
-            put16(&mut b, 2, f as u16);
-            put32(&mut b, 4, init_id);
-            b[7..12].copy_from_slice(&serial.to_le_bytes()[..5]);
-        }
-        (false, HeaderType::Fusa) => {
-            put32(&mut b, 0, 1 | init_id << 8);
-            put32(&mut b, 4, f);
-            b[11..16].copy_from_slice(&serial.to_le_bytes()[..5]);
-        }
-    }
+    write_packet_header(&mut b, info, f);
     for c in 0..info.columns_per_packet {
         let m = first + c;
         let at = layout.column_offset(c);
@@ -166,113 +145,7 @@ fn packet(info: &SensorInfo, f: u32, first: usize, invalid: Option<usize>) -> Ve
 
 /// An Ethernet frame (with an 802.1Q tag when `vlan`) carrying a UDP datagram in IPv4.
 fn ethernet(payload: &[u8], port: u16, vlan: bool) -> Vec<u8> {
-    let mut udp = Vec::new();
-    udp.extend_from_slice(&7502u16.to_be_bytes());
-    udp.extend_from_slice(&port.to_be_bytes());
-    udp.extend_from_slice(&((payload.len() + 8) as u16).to_be_bytes());
-    udp.extend_from_slice(&[0, 0]);
-    udp.extend_from_slice(payload);
-    ip_frames(&udp, 1, usize::MAX, vlan).remove(0)
-}
-
-/// Ethernet frames carrying IPv4 packets of `ip_payload` with id `id`, fragmented so that
-/// each fragment carries at most `mtu_payload` bytes (a multiple of 8).
-fn ip_frames(ip_payload: &[u8], id: u16, mtu_payload: usize, vlan: bool) -> Vec<Vec<u8>> {
-    let mut frames = Vec::new();
-    let mut offset = 0;
-    while offset < ip_payload.len() || offset == 0 {
-        let end = ip_payload.len().min(offset.saturating_add(mtu_payload));
-        let more = end < ip_payload.len();
-        let mut f = vec![0u8; 12];
-        if vlan {
-            f.extend_from_slice(&[0x81, 0x00, 0x00, 0x05]);
-        }
-        f.extend_from_slice(&[0x08, 0x00]);
-        let total = (20 + end - offset) as u16;
-        let flags = (offset / 8) as u16 | if more { 0x2000 } else { 0 };
-        f.extend_from_slice(&[0x45, 0]);
-        f.extend_from_slice(&total.to_be_bytes());
-        f.extend_from_slice(&id.to_be_bytes());
-        f.extend_from_slice(&flags.to_be_bytes());
-        f.extend_from_slice(&[64, 17, 0, 0, 10, 5, 5, 1, 10, 5, 5, 2]);
-        f.extend_from_slice(&ip_payload[offset..end]);
-        frames.push(f);
-        offset = end;
-        if !more {
-            break;
-        }
-    }
-    frames
-}
-
-/// A classic pcap of Ethernet frames, microsecond or nanosecond stamps, either byte order.
-fn classic(frames: &[Vec<u8>], big: bool, nanos: bool) -> Vec<u8> {
-    let w32 = |v: u32| {
-        if big {
-            v.to_be_bytes()
-        } else {
-            v.to_le_bytes()
-        }
-    };
-    let w16 = |v: u16| {
-        if big {
-            v.to_be_bytes()
-        } else {
-            v.to_le_bytes()
-        }
-    };
-    let mut b = Vec::new();
-    b.extend_from_slice(&w32(if nanos { 0xa1b2_3c4d } else { 0xa1b2_c3d4 }));
-    b.extend_from_slice(&w16(2));
-    b.extend_from_slice(&w16(4));
-    b.extend_from_slice(&[0; 8]);
-    b.extend_from_slice(&w32(65535));
-    b.extend_from_slice(&w32(1));
-    for (k, f) in frames.iter().enumerate() {
-        b.extend_from_slice(&w32(1_700_000_000 + k as u32));
-        b.extend_from_slice(&w32(500));
-        b.extend_from_slice(&w32(f.len() as u32));
-        b.extend_from_slice(&w32(f.len() as u32));
-        b.extend_from_slice(f);
-    }
-    b
-}
-
-/// A little-endian pcapng: section header, one Ethernet interface with nanosecond
-/// resolution, a name-resolution block to skip, and one enhanced packet block per frame.
-fn pcapng(frames: &[Vec<u8>]) -> Vec<u8> {
-    let block = |kind: u32, body: &[u8]| {
-        let mut body = body.to_vec();
-        while body.len() % 4 != 0 {
-            body.push(0);
-        }
-        let total = (body.len() + 12) as u32;
-        let mut b = kind.to_le_bytes().to_vec();
-        b.extend_from_slice(&total.to_le_bytes());
-        b.extend_from_slice(&body);
-        b.extend_from_slice(&total.to_le_bytes());
-        b
-    };
-    let mut shb = 0x1a2b_3c4du32.to_le_bytes().to_vec();
-    shb.extend_from_slice(&[1, 0, 0, 0]);
-    shb.extend_from_slice(&u64::MAX.to_le_bytes());
-    let mut out = block(0x0a0d_0d0a, &shb);
-    let mut idb = vec![1, 0, 0, 0];
-    idb.extend_from_slice(&0u32.to_le_bytes());
-    idb.extend_from_slice(&[9, 0, 1, 0, 9, 0, 0, 0, 0, 0, 0, 0]);
-    out.extend(block(1, &idb));
-    out.extend(block(4, &[0, 0, 0, 0]));
-    for (k, f) in frames.iter().enumerate() {
-        let ns = 1_700_000_000_000_000_000u64 + k as u64;
-        let mut epb = 0u32.to_le_bytes().to_vec();
-        epb.extend_from_slice(&((ns >> 32) as u32).to_le_bytes());
-        epb.extend_from_slice(&(ns as u32).to_le_bytes());
-        epb.extend_from_slice(&(f.len() as u32).to_le_bytes());
-        epb.extend_from_slice(&(f.len() as u32).to_le_bytes());
-        epb.extend_from_slice(f);
-        out.extend(block(6, &epb));
-    }
-    out
+    udp_frames(payload, port, 1, usize::MAX, vlan).remove(0)
 }
 
 fn read(info: &SensorInfo, bytes: Vec<u8>) -> Result<Vec<OusterFrame>> {
@@ -387,12 +260,7 @@ fn fragments_are_reassembled() {
     let mut frames = Vec::new();
     for (k, first) in [0usize, 4].into_iter().enumerate() {
         let payload = packet(&info, 41, first, None);
-        let mut udp = 7502u16.to_be_bytes().to_vec();
-        udp.extend_from_slice(&7502u16.to_be_bytes());
-        udp.extend_from_slice(&((payload.len() + 8) as u16).to_be_bytes());
-        udp.extend_from_slice(&[0, 0]);
-        udp.extend_from_slice(&payload);
-        let mut parts = ip_frames(&udp, 100 + k as u16, 64, false);
+        let mut parts = ip_frames(&udp_datagram(&payload, 7502), 100 + k as u16, 64, false);
         assert!(parts.len() > 3);
         parts.swap(0, 2);
         frames.push(parts);
