@@ -26,7 +26,9 @@
 //!   [`raypath_geometry::Pose3`] for 3-D data, in REP-103 frames, metres, radians and seconds.
 //! * **Errors name the place.** Malformed, truncated or mutated input gives an [`Error`] that
 //!   prints as `file:line: reason` or `file: byte N: reason`. No reader panics on any input;
-//!   property tests feed each one thousands of truncated and mutated files.
+//!   property tests feed each one thousands of truncated and mutated files, and
+//!   `cargo xtask fuzz` 10⁵ more per reader, all starting from the small valid files of
+//!   [`samples`] (usable in your own tests too).
 //!
 //! ## Conventions
 //!
