@@ -74,7 +74,7 @@
 //! | [`ReflectionModel`] | `maximum_likelihood` (Eq. 7.22) or `posterior` (Beta, Eq. 8.22), both on a [`BernoulliField`] |
 //! | [`LogOddsModel`], [`LikelihoodFieldModel`] | OctoMap occupancy; AMCL likelihood field with exact distance transform ([`edt`]) |
 //! | [`BetaPrior`], [`GammaPrior`], [`MomentStatistics`] | conjugate priors and their method-of-moments estimates (Sec. 8.5) |
-//! | [`Tabulated`], [`OpticalDepthTable`] | O(1) 2-D ray integrals from cumulative optical depth along 360 directions |
+//! | [`Tabulated`], [`OpticalDepthTable`] | O(1) 2-D ray integrals from cumulative optical depth along 360 directions (ML and posterior decay-rate and reflection models, log-odds, likelihood-field normalizer) |
 //! | [`ScanLikelihood`], [`PreparedScan`] | (pose, scan or cloud) → summed ray log-likelihood (rays independent, Eq. 7.15) |
 //! | [`SensorRange`], [`Reading`] | `r_min`, `r_max` and the classification of a reading as return / `sup` / `sub` (Eq. 7.14) |
 //! | [`export`] | ROS `map_server` PGM + YAML, PNG, and the binary `.rpmap` format `raypath map` writes and `raypath localize` reads |
@@ -156,7 +156,15 @@
 //! look-ups in ~200 MB) gain little except for the likelihood field, whose per-ray
 //! normalizer is a second integral; the gain grows with ray length and with the spread of
 //! particle poses (the `mcl` evaluation measures whole filter updates). The Gamma posterior
-//! costs two logarithms per cell. Measured on the shared 2-core machine while other builds
+//! costs two logarithms per cell; its table counts every crossed cell at the mean chord of
+//! the direction (its miss exponent `a ln(1 + d/b)` is not linear in the length `d`, see
+//! [`Tabulated`]), exact for well-observed cells.
+//!
+//! Table accuracy on the same Intel map (`tests/real_carmen.rs`, scans at the true pose and
+//! up to 0.5 m / 0.15 rad away, 360 blended directions): relative error of the scan
+//! log-likelihood, median (p95), and how often two poses are ordered as by the exact model —
+//! decay-rate 0.8 % (22 %), 0.982; decay-rate posterior 0.6 % (23 %), 0.995; reflection
+//! 0.6 % (11 %), 0.986. Measured on the shared 2-core machine while other builds
 //! ran; treat the figures as lower bounds.
 //!
 //! Map building (`raypath map`, all cores): the corrected Intel log (163 800 beams, 0.1 m
