@@ -145,11 +145,15 @@
 //! | model | 2-D exact [rays/s] | 2-D tabulated [rays/s] | 180-beam scans/s exact / tabulated | 3-D exact [rays/s] |
 //! |---|---|---|---|---|
 //! | decay-rate | 2.74 M | 2.93 M | 15 900 / 15 900 | 1.36 M |
-//! | decay-rate posterior | 1.24 M | — | 7 900 / — | 0.75 M |
+//! | decay-rate posterior | 1.24 M | ≈ 0.8 × decay-rate¹ | 7 900 / ≈ decay-rate¹ | 0.75 M |
 //! | reflection | 2.13 M | 2.59 M | 12 600 / 12 900 | 1.34 M |
 //! | reflection posterior | 2.10 M | 2.42 M | 12 600 / 13 500 | 1.35 M |
 //! | log-odds | 2.24 M | 2.30 M | 12 500 / 13 700 | 1.29 M |
 //! | likelihood field | 0.72 M | 2.69 M | 4 000 / 15 500 | 1.06 M |
+//!
+//! ¹ The posterior's table was added later and measured in a separate run on a heavily
+//! loaded machine, beside the ML decay-rate table in the same run: 437 K vs 555 K rays/s and
+//! 2 520 vs 2 410 scans/s (every figure of that run 4–6 × below the table above).
 //!
 //! On the Intel map the test rays are short (a few metres, some 40 cells), so the exact
 //! traversal is already cheap and the tables (360 directions, blended: four scattered
