@@ -4,7 +4,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // test code: a panic is the failure report
 
 use nalgebra::{Point2, Point3};
-use raypath_geometry::{Aabb2, Grid2, Grid3, Pose2, Pose3, Range, Ray3, Scan2};
+use raypath_geometry::{Aabb2, Grid2, Grid3, Pose2, Pose3, Range, Ray2, Ray3, Scan2};
 use raypath_localizer::eval::{EvaluationConfig, evaluate_trajectory};
 use raypath_localizer::init::GaussianInit;
 use raypath_localizer::lidar::{
@@ -13,8 +13,9 @@ use raypath_localizer::lidar::{
 };
 use raypath_localizer::{MeasurementModel, PoseTrack, Stamped};
 use raypath_sensor_models::{
-    DecayRateConfig, DecayRateModel2, DecayRateModel3, DenseStats2, DenseStats3, MappingConfig,
-    ScanLikelihood,
+    CellStats, DecayRateConfig, DecayRateModel2, DecayRateModel3, DecayRatePosteriorModel2,
+    DenseStats2, DenseStats3, GammaPosteriorConfig, GammaPrior, MappingConfig, OpticalDepthConfig,
+    ScanLikelihood, SensorModel,
 };
 use raypath_sim::indoor::{FloorPlanConfig, Laser2Config, WorldConfig, simulate_world};
 
@@ -359,4 +360,153 @@ fn mcl_converges_on_a_simulated_office_and_is_deterministic_on_1_and_2_threads()
     assert!(evaluation.length_m > 10.0);
     assert!(late_mean < 0.25, "late mean error {late_mean}");
     assert!(evaluation.heading_rad.mean_abs < 0.1);
+}
+
+/// The no-mixture, untempered adapter settings: the scan weight is the plain sum of the ray
+/// log-likelihoods (Eq. 7.15).
+const PLAIN: LidarConfig = LidarConfig {
+    beam_step: 1,
+    effective_beams: None,
+    random_weight: 0.0,
+};
+
+/// The decay-rate full map posterior as the filter builds it (`ModelSpec` with `posterior`)
+/// is the sensor-models model with the method-of-moments prior (Sec. 8.5), and on known rays
+/// both equal the closed form of Sec. 8.4.5 written out here as the reference:
+/// `ln L = −Σ_i (H_i + α) ln(1 + r_i / (R_i + β)) + ln(H_k + α) − ln(R_k + β + r_k)`.
+/// The filter's adapter weighs a one-beam scan with exactly that value; the tabulated
+/// variant stays close.
+#[test]
+fn decay_rate_fmp_in_the_filter_is_the_closed_form_posterior() {
+    let (stats, scans) = room();
+    let range = MappingConfig::default().range;
+    let exact = ModelSpec {
+        kind: ModelKind::DecayRate,
+        posterior: true,
+        tabulated: None,
+    };
+    let tabulated = ModelSpec {
+        tabulated: Some(OpticalDepthConfig::default()),
+        ..exact
+    };
+    assert_eq!(exact.label(), "decay-rate (FMP)");
+    assert_eq!(tabulated.label(), "decay-rate (FMP) [table]");
+    let built = exact.build(&stats, range).unwrap();
+    let built_table = tabulated.build(&stats, range).unwrap();
+    let library =
+        DecayRatePosteriorModel2::new(&stats, GammaPosteriorConfig { range, prior: None }).unwrap();
+    let prior = GammaPrior::estimate(stats.cells());
+    assert_eq!(library.prior(), prior);
+    let reference = |ray: &Ray2| {
+        let crossings: Vec<_> = stats.grid().traverse_ray(ray, range.max_range_m).collect();
+        let mut value = 0.0;
+        for c in &crossings {
+            let cell = stats.cell(c.index);
+            let (a, b) = (cell.h() + prior.alpha, cell.path_length_m() + prior.beta);
+            value -= a * (c.length() / b).ln_1p();
+        }
+        let k = crossings.last().unwrap();
+        let cell = stats.cell(k.index);
+        let (a, b) = (cell.h() + prior.alpha, cell.path_length_m() + prior.beta);
+        value + a.ln() - (b + k.length()).ln()
+    };
+    // Beams of the mapping scans seen from 0.13 m / 0.05 rad off the mapping pose (so that
+    // no endpoint lies on a cell face).
+    let (pose, scan) = &scans[1];
+    let off = *pose * Pose2::new(0.13, -0.07, 0.05);
+    let (mut sum_exact, mut sum_table) = (0.0, 0.0);
+    for (j, ray) in scan.rays(off).enumerate().step_by(15) {
+        let expected = reference(&ray);
+        let got = built.ray_log_likelihood(&ray);
+        assert!(expected.is_finite(), "{expected}");
+        assert!((got - expected).abs() < 1e-9 * (1.0 + expected.abs()));
+        assert_eq!(got, library.ray_log_likelihood(&ray));
+        sum_exact += got;
+        sum_table += built_table.ray_log_likelihood(&ray);
+        // A one-beam scan through the filter's adapter.
+        let one_beam = Scan2 {
+            angle_min_rad: scan.angle(j),
+            angle_increment_rad: 0.0,
+            max_range_m: scan.max_range_m,
+            ranges: vec![scan.ranges[j]],
+            intensities: None,
+        };
+        let adapter = Scan2Measurement::new(built.as_ref(), Pose2::identity(), PLAIN).unwrap();
+        let weight = adapter.log_likelihood(&off, &adapter.prepare(&one_beam));
+        assert!((weight - expected).abs() < 1e-9 * (1.0 + expected.abs()));
+    }
+    assert!(
+        (sum_table / sum_exact - 1.0).abs() < 0.05,
+        "{sum_table} vs {sum_exact}"
+    );
+}
+
+/// Sec. 8.4.3: with `n` times the observations of every cell (each hit at least once, so
+/// the MLM floor of 1e-3 /m plays no part) the Gamma posterior concentrates on the ML rate
+/// and the filter's FMP weights tend to the MLM weights: the ratio of the scan
+/// log-likelihoods MLM / FMP tends to 1, exact and tabulated. (A never-hit cell does not
+/// converge: its ML rate 0 is floored, its posterior mean α / (nR + β) → 0.)
+#[test]
+fn decay_rate_fmp_weights_tend_to_mlm_with_many_observations() {
+    let grid = Grid2::new(Point2::new(0.0, 0.0), 0.5, [24, 24]).unwrap();
+    let base: Vec<(u32, u32, f64)> = (0..grid.num_cells())
+        .map(|i| {
+            let f = i as f64;
+            (
+                1 + (i % 5) as u32,
+                (i * 7 % 23) as u32,
+                0.5 + 11.0 * (0.5 + 0.5 * (f * 0.37).sin()),
+            )
+        })
+        .collect();
+    let scan = Scan2 {
+        angle_min_rad: -3.0,
+        angle_increment_rad: 0.1,
+        max_range_m: 30.0,
+        ranges: (0..60)
+            .map(|j| 0.3 + 4.0 * (0.5 + 0.5 * (j as f64 * 1.7).sin()))
+            .collect(),
+        intensities: None,
+    };
+    let range = MappingConfig::default().range;
+    let pose = Pose2::new(6.1, 5.9, 0.3);
+    for table in [None, Some(OpticalDepthConfig::default())] {
+        let mut previous = f64::INFINITY;
+        for n in [1u32, 10, 100, 1000] {
+            let cells = base
+                .iter()
+                .map(|&(h, m, r)| CellStats::new(h * n, m * n, r * f64::from(n)))
+                .collect();
+            let stats = DenseStats2::from_parts(grid, cells, Default::default()).unwrap();
+            let spec = ModelSpec {
+                kind: ModelKind::DecayRate,
+                posterior: false,
+                tabulated: table,
+            };
+            let weight = |spec: ModelSpec| {
+                let model = spec.build(&stats, range).unwrap();
+                let adapter =
+                    Scan2Measurement::new(model.as_ref(), Pose2::identity(), PLAIN).unwrap();
+                adapter.log_likelihood(&pose, &adapter.prepare(&scan))
+            };
+            let (ml, fmp) = (
+                weight(spec),
+                weight(ModelSpec {
+                    posterior: true,
+                    ..spec
+                }),
+            );
+            let gap = (ml / fmp - 1.0).abs();
+            eprintln!(
+                "table {}: n = {n}: MLM {ml:.2}, FMP {fmp:.2}, |ratio − 1| {gap:.2e}",
+                table.is_some()
+            );
+            assert!(
+                ml < -10.0 && gap < 0.5 * previous,
+                "n = {n}: {gap} vs {previous}"
+            );
+            previous = gap;
+        }
+        assert!(previous < 1e-3, "{previous}");
+    }
 }

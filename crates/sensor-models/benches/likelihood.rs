@@ -223,6 +223,8 @@ fn likelihood_2d(c: &mut Criterion) {
     let m = models(&stats, range);
     let od = OpticalDepthConfig::default();
     let tab_decay = Tabulated::<DecayRateModel<_>>::new(m.decay_ml.clone(), od).unwrap();
+    let tab_decay_post =
+        Tabulated::<DecayRatePosteriorModel<_>>::new(m.decay_posterior.clone(), od).unwrap();
     let tab_reflection = Tabulated::<ReflectionModel<_>>::new(m.reflection_ml.clone(), od).unwrap();
     let tab_reflection_post =
         Tabulated::<ReflectionModel<_>>::new(m.reflection_posterior.clone(), od).unwrap();
@@ -264,6 +266,12 @@ fn likelihood_2d(c: &mut Criterion) {
     bench_rays(&mut group, "log-odds", &m.log_odds, &rays);
     bench_rays(&mut group, "likelihood-field", &m.likelihood_field, &rays);
     bench_rays(&mut group, "decay-rate-tabulated", &tab_decay, &rays);
+    bench_rays(
+        &mut group,
+        "decay-rate-posterior-tabulated",
+        &tab_decay_post,
+        &rays,
+    );
     bench_rays(&mut group, "reflection-tabulated", &tab_reflection, &rays);
     bench_rays(
         &mut group,
@@ -299,6 +307,12 @@ fn likelihood_2d(c: &mut Criterion) {
     bench_scans(&mut group, "log-odds", &m.log_odds, &test);
     bench_scans(&mut group, "likelihood-field", &m.likelihood_field, &test);
     bench_scans(&mut group, "decay-rate-tabulated", &tab_decay, &test);
+    bench_scans(
+        &mut group,
+        "decay-rate-posterior-tabulated",
+        &tab_decay_post,
+        &test,
+    );
     bench_scans(&mut group, "reflection-tabulated", &tab_reflection, &test);
     bench_scans(
         &mut group,

@@ -12,9 +12,10 @@ use raypath_geometry::{Grid2, Range, Ray2};
 use raypath_sensor_models::{
     BetaPosteriorConfig, BetaPrior, CellStats, DecayRateConfig, DecayRateModel2,
     DecayRatePosteriorModel2, DenseStats2, GammaPosteriorConfig, GammaPrior, LikelihoodFieldConfig,
-    LikelihoodFieldModel2, LogOddsConfig, LogOddsModel2, MappingConfig, Planar, ReflectionConfig,
-    ReflectionModel2, SensorModel, SensorRange,
+    LikelihoodFieldModel2, LogOddsConfig, LogOddsModel2, MappingConfig, OpticalDepthConfig, Planar,
+    ReflectionConfig, ReflectionModel2, SensorModel, SensorRange, Tabulated,
 };
+use std::f64::consts::{FRAC_PI_2, PI};
 
 /// A 12 m × 12 m grid of 0.5 m cells at the origin.
 fn grid() -> Grid2 {
@@ -372,4 +373,157 @@ fn constant_medium_recovers_the_decay_rate() {
     for (i, rate) in model.rates().iter().take(20).enumerate() {
         assert!((rate / lambda - 1.0).abs() < 0.25, "cell {i}: λ = {rate}");
     }
+}
+
+/// Per-cell statistics with every cell hit (so the ML rate `H/R` is positive) scaled by `n`:
+/// `n` times the observations of the same map.
+fn observed_stats_times(n: u32) -> DenseStats2 {
+    let grid = grid();
+    let mut rng = ChaCha8Rng::seed_from_u64(17);
+    let cells = (0..grid.num_cells())
+        .map(|_| {
+            let (h, m, r) = (
+                rng.random_range(1..6u32),
+                rng.random_range(0..30u32),
+                rng.random_range(0.5..12.0),
+            );
+            CellStats::new(h * n, m * n, r * f64::from(n))
+        })
+        .collect();
+    DenseStats2::from_parts(grid, cells, Default::default()).unwrap()
+}
+
+/// Sec. 8.4.3–8.4.5: with `n` times the observations per cell the Gamma posterior
+/// Gamma(nH + α, nR + β) concentrates on the ML rate H/R (the prior, a function of the ML
+/// rates, stays the same), so the FMP likelihood L(z, x) tends to the MLM likelihood: per
+/// ray the gap shrinks like 1/n and the ratio of summed log-likelihoods (the thesis's
+/// Table 8.2 ratio) tends to 1.
+#[test]
+fn posterior_tends_to_the_ml_map_with_many_observations() {
+    let range = SensorRange::new(0.0, 4.8).unwrap();
+    let mut test_rays = rays(23, 60);
+    test_rays.extend(rays(29, 20).into_iter().map(|ray| Ray2 {
+        range: Range::NoReturn,
+        ..ray
+    }));
+    let mut previous: Option<(f64, f64)> = None;
+    for n in [1u32, 10, 100, 1000, 10_000] {
+        let stats = observed_stats_times(n);
+        let ml = DecayRateModel2::new(
+            &stats,
+            DecayRateConfig {
+                range,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let fmp =
+            DecayRatePosteriorModel2::new(&stats, GammaPosteriorConfig { range, prior: None })
+                .unwrap();
+        let prior_n1 = GammaPrior::estimate(observed_stats_times(1).cells());
+        assert!((fmp.prior().alpha / prior_n1.alpha - 1.0).abs() < 1e-9);
+        let (mut sum_ml, mut sum_fmp, mut max_gap) = (0.0, 0.0, 0.0f64);
+        for ray in &test_rays {
+            let (a, b) = (ml.ray_log_likelihood(ray), fmp.ray_log_likelihood(ray));
+            assert!(a.is_finite() && b.is_finite());
+            sum_ml += a;
+            sum_fmp += b;
+            max_gap = max_gap.max((a - b).abs());
+        }
+        assert!(sum_ml < -10.0, "sum {sum_ml}");
+        let ratio = sum_ml / sum_fmp;
+        eprintln!("n = {n}: ratio MLM/FMP {ratio:.6}, largest per-ray gap {max_gap:.2e} nats");
+        if let Some((previous_gap, previous_ratio)) = previous {
+            assert!(max_gap < 0.5 * previous_gap, "n = {n}: gap {max_gap}");
+            assert!((ratio - 1.0).abs() <= (previous_ratio - 1.0).abs() + 1e-12);
+        }
+        previous = Some((max_gap, ratio));
+    }
+    let (gap, ratio) = previous.unwrap();
+    assert!(gap < 2e-3 && (ratio - 1.0).abs() < 1e-4, "{gap} {ratio}");
+}
+
+/// The tabulated posterior (every crossed cell counted at the mean chord of its direction):
+/// on a uniform map, along a grid axis from a cell face to a cell face (no-returns end on one
+/// at r_max), every chord is the cell edge, so it
+/// equals the exact Sec. 8.4.5 likelihood up to the table's f32 rounding; on a random map
+/// in any direction it stays close.
+#[test]
+fn tabulated_posterior_follows_the_exact_model() {
+    let range = SensorRange::new(0.0, 4.5).unwrap();
+    let build = |stats: &DenseStats2, prior: Option<GammaPrior>| {
+        let exact =
+            DecayRatePosteriorModel2::new(stats, GammaPosteriorConfig { range, prior }).unwrap();
+        let table = Tabulated::<DecayRatePosteriorModel2>::new(
+            exact.clone(),
+            OpticalDepthConfig::default(),
+        )
+        .unwrap();
+        (exact, table)
+    };
+    // Uniform cells with a small posterior rate b = R + β, where ln(1 + d/b) is far from
+    // linear in d.
+    let grid = grid();
+    let uniform = DenseStats2::from_parts(
+        grid,
+        vec![CellStats::new(2, 10, 0.4); grid.num_cells()],
+        Default::default(),
+    )
+    .unwrap();
+    let (exact, table) = build(&uniform, Some(GammaPrior::new(0.5, 0.1).unwrap()));
+    for (k, angle) in [0.0, FRAC_PI_2, PI, -FRAC_PI_2].into_iter().enumerate() {
+        for range in [
+            Range::Hit(0.3),
+            Range::Hit(2.0),
+            Range::Hit(3.77),
+            Range::NoReturn,
+        ] {
+            // Origin on a cell face (x = 6 or y = 6), in the middle of a cell across.
+            let origin = if k % 2 == 0 {
+                Point2::new(6.0, 6.25)
+            } else {
+                Point2::new(5.75, 6.0)
+            };
+            let ray = Ray2::from_angle(origin, angle, range);
+            let (e, t) = (
+                exact.ray_log_likelihood(&ray),
+                table.ray_log_likelihood(&ray),
+            );
+            assert!(
+                (e - t).abs() < 1e-4 * (1.0 + e.abs()),
+                "{angle} {range:?}: {e} vs {t}"
+            );
+        }
+    }
+    // A random map of 0.5 m cells (rates jumping by orders of magnitude from cell to cell)
+    // is hard for any table; the posterior's mean-chord table errs no more than the ML
+    // decay-rate table (exact chords times a fixed rate) on the same map.
+    let stats = random_stats(5);
+    let (exact, table) = build(&stats, None);
+    let ml = DecayRateModel2::new(
+        &stats,
+        DecayRateConfig {
+            range,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let ml_table =
+        Tabulated::<DecayRateModel2>::new(ml.clone(), OpticalDepthConfig::default()).unwrap();
+    let quantiles = |exact: &dyn SensorModel<Planar>, table: &dyn SensorModel<Planar>| {
+        let mut gaps: Vec<f64> = rays(41, 400)
+            .iter()
+            .map(|ray| (exact.ray_log_likelihood(ray) - table.ray_log_likelihood(ray)).abs())
+            .collect();
+        gaps.sort_by(f64::total_cmp);
+        (gaps[gaps.len() / 2], gaps[gaps.len() * 95 / 100])
+    };
+    let (median, p95) = quantiles(&exact, &table);
+    let (ml_median, ml_p95) = quantiles(&ml, &ml_table);
+    eprintln!(
+        "|Δ| per ray, table vs exact: posterior median {median:.4}, p95 {p95:.4} nats; \
+         ML median {ml_median:.4}, p95 {ml_p95:.4} nats"
+    );
+    assert!(median <= 1.25 * ml_median && p95 <= 1.25 * ml_p95);
+    assert!(median < 0.5 && p95 < 3.0, "median {median}, p95 {p95}");
 }

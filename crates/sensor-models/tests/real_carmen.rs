@@ -164,6 +164,7 @@ fn optical_depth_table_accuracy() {
     let decay = DecayRateModel2::new(&stats, DecayRateConfig::default()).unwrap();
     let reflection =
         ReflectionModel2::maximum_likelihood(&stats, ReflectionConfig::default()).unwrap();
+    let posterior = DecayRatePosteriorModel2::new(&stats, GammaPosteriorConfig::default()).unwrap();
     for blend in [false, true] {
         let config = OpticalDepthConfig {
             blend_directions: blend,
@@ -179,6 +180,8 @@ fn optical_depth_table_accuracy() {
         );
         let reflection_table =
             Tabulated::<ReflectionModel2>::new(reflection.clone(), config).unwrap();
+        let posterior_table =
+            Tabulated::<DecayRatePosteriorModel2>::new(posterior.clone(), config).unwrap();
         for (name, exact, table) in [
             (
                 "decay-rate",
@@ -186,6 +189,7 @@ fn optical_depth_table_accuracy() {
                 &decay_table as &dyn SensorModel<Planar>,
             ),
             ("reflection", &reflection, &reflection_table),
+            ("decay-rate posterior", &posterior, &posterior_table),
         ] {
             let exact = ScanLikelihood::new(exact);
             let table = ScanLikelihood::new(table);

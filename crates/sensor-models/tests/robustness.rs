@@ -8,10 +8,10 @@ use raypath_geometry::testing::{grid2, grid3, ray2_in, ray3_in};
 use raypath_geometry::{Grid2, Range, Ray2};
 use raypath_sensor_models::{
     BetaPosteriorConfig, DecayRateConfig, DecayRateModel, DecayRateModel2, DecayRatePosteriorModel,
-    DenseStats, DenseStats2, Dimension, GammaPosteriorConfig, LikelihoodFieldConfig,
-    LikelihoodFieldModel, LikelihoodFieldModel2, LogOddsConfig, LogOddsModel, LogOddsModel2,
-    MappingConfig, OpticalDepthConfig, ReflectionConfig, ReflectionModel, ReflectionModel2,
-    SensorModel, Tabulated,
+    DecayRatePosteriorModel2, DenseStats, DenseStats2, Dimension, GammaPosteriorConfig,
+    LikelihoodFieldConfig, LikelihoodFieldModel, LikelihoodFieldModel2, LogOddsConfig,
+    LogOddsModel, LogOddsModel2, MappingConfig, OpticalDepthConfig, ReflectionConfig,
+    ReflectionModel, ReflectionModel2, SensorModel, Tabulated,
 };
 
 /// Every model of `stats`, boxed.
@@ -73,6 +73,16 @@ fn tabulated_models(
                 Tabulated::<ReflectionModel2>::new(
                     ReflectionModel2::maximum_likelihood(stats, ReflectionConfig::default())
                         .unwrap(),
+                    config,
+                )
+                .unwrap(),
+            ),
+        ),
+        (
+            "decay-rate posterior table",
+            Box::new(
+                Tabulated::<DecayRatePosteriorModel2>::new(
+                    DecayRatePosteriorModel2::new(stats, GammaPosteriorConfig::default()).unwrap(),
                     config,
                 )
                 .unwrap(),

@@ -80,16 +80,24 @@ impl FromStr for ModelKind {
 pub struct ModelSpec {
     /// The model.
     pub kind: ModelKind,
-    /// The full-map-posterior variant (decay-rate and reflection only; ignored otherwise).
+    /// The full-map-posterior variant (FMP, Schaefer 2020, Sec. 8.4.4–8.4.5; decay-rate and
+    /// reflection only; ignored otherwise): the closed-form likelihood `L(z, x)` with the
+    /// map integrated out under the Gamma (decay-rate) or Beta (reflection) posterior, the
+    /// prior's α, β estimated from the map by the method of moments (Sec. 8.5,
+    /// [`raypath_sensor_models::GammaPrior::estimate`],
+    /// [`raypath_sensor_models::BetaPrior::estimate`]). The MLM and FMP variants of a model
+    /// are built from the same statistics and differ only in the weighting.
     pub posterior: bool,
     /// Look path integrals up in an optical-depth table instead of traversing the grid
-    /// (O(1) per ray; not available for the decay-rate posterior, which stays exact; the
-    /// unnormalized likelihood field needs no path integral).
+    /// (O(1) per ray, approximate; for the decay-rate posterior every crossed cell counts
+    /// as crossed for the mean chord of its direction, see
+    /// [`raypath_sensor_models::Tabulated`]; the unnormalized likelihood field needs no
+    /// path integral and stays exact).
     pub tabulated: Option<OpticalDepthConfig>,
 }
 
 impl ModelSpec {
-    /// The exact (traversing) model of `kind`, maximum likelihood.
+    /// The exact (traversing) model of `kind`, maximum likelihood (MLM).
     pub fn exact(kind: ModelKind) -> Self {
         Self {
             kind,
@@ -98,7 +106,7 @@ impl ModelSpec {
         }
     }
 
-    /// The tabulated model of `kind` with the default table, maximum likelihood.
+    /// The tabulated model of `kind` with the default table, maximum likelihood (MLM).
     pub fn tabulated(kind: ModelKind) -> Self {
         Self {
             kind,
@@ -120,11 +128,7 @@ impl ModelSpec {
     }
 
     fn uses_table(&self) -> bool {
-        match self.kind {
-            ModelKind::DecayRate => !self.posterior,
-            ModelKind::LikelihoodField => false,
-            _ => true,
-        }
+        self.kind != ModelKind::LikelihoodField
     }
 
     /// Builds the model on `stats` with range limits `range`.
@@ -160,10 +164,19 @@ impl ModelSpec {
                     None => Box::new(model),
                 }
             }
-            (ModelKind::DecayRate, true) => Box::new(DecayRatePosteriorModel2::new(
-                stats,
-                GammaPosteriorConfig { range, prior: None },
-            )?),
+            (ModelKind::DecayRate, true) => {
+                // Sec. 8.4.5, prior by the method of moments (Sec. 8.5).
+                let model = DecayRatePosteriorModel2::new(
+                    stats,
+                    GammaPosteriorConfig { range, prior: None },
+                )?;
+                match table {
+                    Some(config) => {
+                        Box::new(Tabulated::<DecayRatePosteriorModel2>::new(model, config)?)
+                    }
+                    None => Box::new(model),
+                }
+            }
             (ModelKind::Reflection, posterior) => {
                 let model = if posterior {
                     ReflectionModel2::posterior(stats, BetaPosteriorConfig { range, prior: None })?

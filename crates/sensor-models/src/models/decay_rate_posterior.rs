@@ -92,6 +92,16 @@ impl<D: Dimension> DecayRatePosteriorModel<D> {
         &self.params
     }
 
+    /// The configuration (`prior` as given; [`Self::prior`] is the prior in use).
+    pub fn config(&self) -> &GammaPosteriorConfig {
+        &self.config
+    }
+
+    /// The rate `κ₀ = (α / c) ln(1 + c/β)` in 1/m of the homogeneous medium outside the grid.
+    pub fn outside_rate_per_m(&self) -> f64 {
+        self.outside_rate
+    }
+
     /// Posterior mean decay rate `a_i / b_i` of cell `index` in 1/m.
     pub fn mean_rate(&self, index: usize) -> f64 {
         self.params

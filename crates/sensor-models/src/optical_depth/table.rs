@@ -52,6 +52,87 @@ struct Direction {
     offset: usize,
 }
 
+impl Direction {
+    /// The sample lattice of direction `theta` covering `grid`, one sample spacing beyond
+    /// the box on every side (`offset` 0).
+    fn layout(grid: &Grid2, theta: f64, spacing_m: f64) -> Self {
+        let (sin, cos) = theta.sin_cos();
+        let extent = grid.bounds().extents();
+        // Projections of the box corners (relative to the origin) onto u and v.
+        let corners = [
+            (0.0, 0.0),
+            (extent.x, 0.0),
+            (0.0, extent.y),
+            (extent.x, extent.y),
+        ];
+        let (mut u_lo, mut u_hi, mut v_lo, mut v_hi) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        for (x, y) in corners {
+            let u = x * cos + y * sin;
+            let v = -x * sin + y * cos;
+            u_lo = u_lo.min(u);
+            u_hi = u_hi.max(u);
+            v_lo = v_lo.min(v);
+            v_hi = v_hi.max(v);
+        }
+        let u0 = u_lo - spacing_m;
+        let v0 = v_lo - spacing_m;
+        Self {
+            cos,
+            sin,
+            u0,
+            v0,
+            n_u: ((u_hi - u0) / spacing_m).ceil() as usize + 2,
+            n_v: ((v_hi - v0) / spacing_m).ceil() as usize + 2,
+            offset: 0,
+        }
+    }
+
+    /// The direction angle θ ∈ [0, π).
+    fn angle(&self) -> f64 {
+        self.sin.atan2(self.cos)
+    }
+}
+
+/// One finite, non-negative value per cell of `grid`.
+fn check_field(grid: &Grid2, field: &[f64]) -> Result<(), SensorModelError> {
+    if field.len() != grid.num_cells() {
+        return Err(SensorModelError::GridMismatch {
+            reason: format!(
+                "{} field values for {} cells",
+                field.len(),
+                grid.num_cells()
+            ),
+        });
+    }
+    if field.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
+        return Err(SensorModelError::InvalidParameter {
+            name: "field",
+            reason: "values must be finite and non-negative".into(),
+        });
+    }
+    Ok(())
+}
+
+/// 1 to 65 536 directions and a sample spacing of 0.05 to 16 cells.
+fn check_config(config: &OpticalDepthConfig) -> Result<(), SensorModelError> {
+    if config.directions == 0 || config.directions > 1 << 16 {
+        return Err(SensorModelError::InvalidParameter {
+            name: "directions",
+            reason: format!("need 1 to 65536, got {}", config.directions),
+        });
+    }
+    if !(config.spacing_cells.is_finite()
+        && config.spacing_cells >= 0.05
+        && config.spacing_cells <= 16.0)
+    {
+        return Err(SensorModelError::InvalidParameter {
+            name: "spacing_cells",
+            reason: format!("need 0.05 to 16, got {}", config.spacing_cells),
+        });
+    }
+    Ok(())
+}
+
 /// For `D` directions `θ_d = d·π/D`, the grid field `ρ(x)` (piecewise constant on cells)
 /// integrated along parallel lines of direction `θ_d` from the grid border:
 /// `C_d(u, v) = ∫_{−∞}^{u} ρ(u', v) du'` sampled on a rotated lattice (exact traversal of
@@ -80,72 +161,42 @@ impl OpticalDepthTable {
         scale: impl Fn(f64) -> f64 + Sync,
         config: OpticalDepthConfig,
     ) -> Result<Self, SensorModelError> {
-        if field.len() != grid.num_cells() {
-            return Err(SensorModelError::GridMismatch {
-                reason: format!(
-                    "{} field values for {} cells",
-                    field.len(),
-                    grid.num_cells()
-                ),
-            });
-        }
-        if config.directions == 0 || config.directions > 1 << 16 {
-            return Err(SensorModelError::InvalidParameter {
-                name: "directions",
-                reason: format!("need 1 to 65536, got {}", config.directions),
-            });
-        }
-        if !(config.spacing_cells.is_finite()
-            && config.spacing_cells >= 0.05
-            && config.spacing_cells <= 16.0)
-        {
-            return Err(SensorModelError::InvalidParameter {
-                name: "spacing_cells",
-                reason: format!("need 0.05 to 16, got {}", config.spacing_cells),
-            });
-        }
-        if field.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
-            return Err(SensorModelError::InvalidParameter {
-                name: "field",
-                reason: "values must be finite and non-negative".into(),
-            });
-        }
+        check_field(grid, field)?;
+        Self::build(grid, config, |direction, spacing_m| {
+            let theta_scale = scale(direction.angle());
+            Ok(tabulate(grid, field, direction, spacing_m, theta_scale))
+        })
+    }
+
+    /// Tabulates a direction-dependent field: `field(θ_d)` returns, for the direction
+    /// `θ_d ∈ [0, π)`, one value per cell of `grid` (by linear index; per metre, finite and
+    /// non-negative). For integrands that are not a fixed field times a factor of θ, such as
+    /// the Gamma posterior's miss exponent per metre of a mean chord (see [`Tabulated`]'s
+    /// decay-rate posterior). Called once per direction, in parallel.
+    ///
+    /// [`Tabulated`]: crate::Tabulated
+    pub fn directional(
+        grid: &Grid2,
+        field: impl Fn(f64) -> Vec<f64> + Sync,
+        config: OpticalDepthConfig,
+    ) -> Result<Self, SensorModelError> {
+        Self::build(grid, config, |direction, spacing_m| {
+            let values = field(direction.angle());
+            check_field(grid, &values)?;
+            Ok(tabulate(grid, &values, direction, spacing_m, 1.0))
+        })
+    }
+
+    /// Lays out the directions of `config` over `grid` and fills each with `tabulate_one`.
+    fn build(
+        grid: &Grid2,
+        config: OpticalDepthConfig,
+        tabulate_one: impl Fn(&Direction, f64) -> Result<Vec<f32>, SensorModelError> + Sync,
+    ) -> Result<Self, SensorModelError> {
+        check_config(&config)?;
         let spacing_m = config.spacing_cells * grid.cell_size();
-        let extent = grid.bounds().extents();
         let mut directions: Vec<Direction> = (0..config.directions)
-            .map(|d| {
-                let theta = d as f64 * PI / config.directions as f64;
-                let (sin, cos) = theta.sin_cos();
-                // Projections of the box corners (relative to the origin) onto u and v.
-                let corners = [
-                    (0.0, 0.0),
-                    (extent.x, 0.0),
-                    (0.0, extent.y),
-                    (extent.x, extent.y),
-                ];
-                let (mut u_lo, mut u_hi, mut v_lo, mut v_hi) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-                for (x, y) in corners {
-                    let u = x * cos + y * sin;
-                    let v = -x * sin + y * cos;
-                    u_lo = u_lo.min(u);
-                    u_hi = u_hi.max(u);
-                    v_lo = v_lo.min(v);
-                    v_hi = v_hi.max(v);
-                }
-                let u0 = u_lo - spacing_m;
-                let v0 = v_lo - spacing_m;
-                let n_u = ((u_hi - u0) / spacing_m).ceil() as usize + 2;
-                let n_v = ((v_hi - v0) / spacing_m).ceil() as usize + 2;
-                Direction {
-                    cos,
-                    sin,
-                    u0,
-                    v0,
-                    n_u,
-                    n_v,
-                    offset: 0,
-                }
-            })
+            .map(|d| Direction::layout(grid, d as f64 * PI / config.directions as f64, spacing_m))
             .collect();
         let mut total = 0usize;
         for direction in &mut directions {
@@ -158,13 +209,10 @@ impl OpticalDepthTable {
                 reason: format!("{total} samples (more than 2^33); use fewer directions"),
             });
         }
-        let tables: Vec<Vec<f32>> = directions
+        let tables = directions
             .par_iter()
-            .map(|direction| {
-                let theta_scale = scale(direction.sin.atan2(direction.cos));
-                tabulate(grid, field, direction, spacing_m, theta_scale)
-            })
-            .collect();
+            .map(|direction| tabulate_one(direction, spacing_m))
+            .collect::<Result<Vec<Vec<f32>>, _>>()?;
         let mut values = Vec::with_capacity(total);
         for table in tables {
             values.extend_from_slice(&table);

@@ -7,8 +7,8 @@ use crate::models::bernoulli::MIN_CHORD_FRACTION;
 use crate::models::{SensorModel, finite_or_neg_inf, ln_one_minus_exp_neg};
 use crate::optical_depth::{OpticalDepthConfig, OpticalDepthTable};
 use crate::{
-    DecayRateModel2, LikelihoodFieldModel2, LogOddsModel2, Reading, ReflectionModel2,
-    SensorModelError, SensorRange,
+    DecayRateModel2, DecayRatePosteriorModel2, LikelihoodFieldModel2, LogOddsModel2, Reading,
+    ReflectionModel2, SensorModelError, SensorRange,
 };
 
 /// A 2-D model whose ray integrals are looked up in an [`OpticalDepthTable`] instead of
@@ -17,6 +17,15 @@ use crate::{
 ///
 /// * [`DecayRateModel2`]: the table holds `∫ λ`; `ln p = ln λ_k − Σ λ_i d_i` (Eq. 7.13) with
 ///   the sum from the table and `λ_k` from the map.
+/// * [`DecayRatePosteriorModel2`] (full map posterior, Sec. 8.4.5): a cell crossed for `d`
+///   metres has the miss exponent `a_i ln(1 + d / b_i)`, not linear in `d`, so it is no line
+///   integral of a fixed field. The table counts every crossed cell as crossed for the mean
+///   chord `d̄(θ) = c / (|cos θ| + |sin θ|)` of a line in direction θ (the inverse of the
+///   reflection model's cells per metre), i.e. it integrates
+///   `ρ_i(θ) = a_i ln(1 + d̄(θ) / b_i) / d̄(θ)` per metre ([`OpticalDepthTable::directional`]);
+///   exact where `d ≪ b_i` (well-observed cells, where it is `a_i / b_i` per metre). The
+///   endpoint cell is evaluated exactly: its share of the table sum is replaced by
+///   `a_k ln(1 + r_k / b_k)` and `ln a_k − ln(b_k + r_k)` is added, `r_k` the in-cell length.
 /// * [`ReflectionModel2`] (ML or posterior) and [`LogOddsModel2`]: the product
 ///   `Π (1 − μ_i)` over crossed cells is `exp(−Σ ρ_i)` with `ρ_i = −ln(1 − μ_i)`; the count
 ///   of cells is turned into a line integral by the mean number of cells a line in
@@ -30,7 +39,8 @@ use crate::{
 pub struct Tabulated<M> {
     model: M,
     table: OpticalDepthTable,
-    /// Per-cell value used at the endpoint (`ln λ_k`, or `[ln μ_k, ρ_k]` flattened).
+    /// Per-cell value used at the endpoint (`ln λ_k`, `[ln μ_k, ρ_k]` or the posterior's
+    /// `[a_k, b_k]`).
     endpoint: Vec<[f64; 2]>,
     /// Integrand outside the grid, per metre.
     outside_rate: f64,
@@ -105,6 +115,83 @@ impl SensorModel<Planar> for Tabulated<DecayRateModel2> {
 
     fn sensor_range(&self) -> SensorRange {
         self.model.config().range
+    }
+}
+
+/// The mean chord `c / (|cos θ| + |sin θ|)` of the cells a line of unit direction `(x, y)`
+/// crosses (cell edge `c`).
+#[inline]
+fn mean_chord(c: f64, x: f64, y: f64) -> f64 {
+    c / (x.abs() + y.abs())
+}
+
+impl Tabulated<DecayRatePosteriorModel2> {
+    /// Tabulates the Gamma posterior's miss exponent per metre of mean chord (see the type
+    /// docs).
+    pub fn new(
+        model: DecayRatePosteriorModel2,
+        config: OpticalDepthConfig,
+    ) -> Result<Self, SensorModelError> {
+        let c = Planar::cell_size(model.grid());
+        let params = model.params();
+        let table = OpticalDepthTable::directional(
+            model.grid(),
+            |theta: f64| {
+                let chord = mean_chord(c, theta.cos(), theta.sin());
+                params
+                    .iter()
+                    .map(|[a, b]| a * (chord / b).ln_1p() / chord) // −ln l_dec(d̄, 0) / d̄, Sec. 8.4.5
+                    .collect()
+            },
+            config,
+        )?;
+        let endpoint = params.to_vec();
+        let outside_rate = model.outside_rate_per_m();
+        Ok(Self {
+            model,
+            table,
+            endpoint,
+            outside_rate,
+        })
+    }
+}
+
+impl SensorModel<Planar> for Tabulated<DecayRatePosteriorModel2> {
+    fn ray_log_likelihood(&self, ray_in_map: &Ray2) -> f64 {
+        let range = self.model.config().range;
+        let value = match range.classify(ray_in_map.range) {
+            Reading::Hit(r) => self.posterior_hit(ray_in_map, r),
+            Reading::Sup => -self.path_integral(ray_in_map, 0.0, range.max_range_m),
+            Reading::Sub => {
+                ln_one_minus_exp_neg(self.path_integral(ray_in_map, 0.0, range.min_range_m))
+            }
+        };
+        finite_or_neg_inf(value)
+    }
+
+    fn sensor_range(&self) -> SensorRange {
+        self.model.config().range
+    }
+}
+
+impl Tabulated<DecayRatePosteriorModel2> {
+    /// `ln L` of a return at `r`: the table's miss exponent with the endpoint cell's share
+    /// replaced by the exact `ln l_dec(r_k, 1)` (Sec. 8.4.5).
+    #[inline]
+    fn posterior_hit(&self, ray: &Ray2, r: f64) -> f64 {
+        let depth = self.path_integral(ray, 0.0, r);
+        let grid = self.model.grid();
+        let Some((k, [a, b])) =
+            Planar::cell_index_at(grid, ray, r).and_then(|k| self.endpoint.get(k).map(|e| (k, e)))
+        else {
+            return self.outside_rate.ln() - depth;
+        };
+        let (t0, _) = Planar::chord(grid, ray, k);
+        let r_k = (r - t0.max(0.0)).max(0.0);
+        let chord = mean_chord(Planar::cell_size(grid), ray.direction.x, ray.direction.y);
+        let own = a * (chord / b).ln_1p() / chord * r_k;
+        // ln l_dec(r_k, 1) = −a_k ln(1 + r_k / b_k) + ln a_k − ln(b_k + r_k), Sec. 8.4.5
+        -(depth - own).max(0.0) - a * (r_k / b).ln_1p() + a.ln() - (b + r_k).ln()
     }
 }
 

@@ -14,8 +14,9 @@ use raypath_localizer::lidar::{LidarConfig, Scan3Measurement};
 use raypath_localizer::motion::Gaussian6DofMotionModel;
 use raypath_localizer::{Estimator, FilterConfig, ParticleFilter, ParticleRng, PoseTrack, Stamped};
 use raypath_sensor_models::{
-    DecayRateConfig, DecayRateModel3, DenseStats3, LikelihoodFieldConfig, LikelihoodFieldModel3,
-    MappingConfig, ReflectionConfig, ReflectionModel3, SensorModel, SensorRange, Spatial,
+    DecayRateConfig, DecayRateModel3, DecayRatePosteriorModel3, DenseStats3, GammaPosteriorConfig,
+    LikelihoodFieldConfig, LikelihoodFieldModel3, MappingConfig, ReflectionConfig,
+    ReflectionModel3, SensorModel, SensorRange, Spatial,
 };
 
 use super::common::{Cell, RunResult};
@@ -108,7 +109,7 @@ pub fn load(root: &Path, frames: usize) -> Result<SpatialProblem> {
 /// A boxed 3-D sensor model.
 pub type BoxedSpatialModel = Box<dyn SensorModel<Spatial> + Send + Sync>;
 
-/// The 3-D models of the table: decay-rate, reflection, endpoint.
+/// The 3-D models of the table: decay-rate (MLM and FMP), reflection, endpoint.
 pub fn models(problem: &SpatialProblem) -> Result<Vec<(String, BoxedSpatialModel)>> {
     let range = problem.range;
     let decay = DecayRateModel3::new(
@@ -118,6 +119,9 @@ pub fn models(problem: &SpatialProblem) -> Result<Vec<(String, BoxedSpatialModel
             ..DecayRateConfig::default()
         },
     )?;
+    // The full map posterior (Sec. 8.4.5), prior by the method of moments (Sec. 8.5).
+    let decay_fmp =
+        DecayRatePosteriorModel3::new(&problem.stats, GammaPosteriorConfig { range, prior: None })?;
     let reflection = ReflectionModel3::maximum_likelihood(
         &problem.stats,
         ReflectionConfig {
@@ -135,6 +139,7 @@ pub fn models(problem: &SpatialProblem) -> Result<Vec<(String, BoxedSpatialModel
     )?;
     Ok(vec![
         ("decay-rate".to_owned(), Box::new(decay)),
+        ("decay-rate (FMP)".to_owned(), Box::new(decay_fmp)),
         ("reflection".to_owned(), Box::new(reflection)),
         ("endpoint".to_owned(), Box::new(endpoint)),
     ])
