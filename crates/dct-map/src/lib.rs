@@ -64,6 +64,7 @@
 //! | [`GridRateMap`], [`initial_map`], [`DctMap::from_grid`], [`DctMap::to_rate_grid`] | the grid baseline (ch. 7) and conversions |
 //! | [`render`] | PNG of `p_ref = 1 − e^{−λ}` |
 //! | [`experiment`] | patch choice, ray draws, ground truth and the DCT-vs-grid comparison of Sec. 9.5 |
+//! | [`baselines`] | GPOM (Matérn) and Hilbert maps (Nyström) with as many parameters, and their rasterized ray likelihood (Sec. 9.5.2) |
 //!
 //! ## Defaults and where they come from
 //!
@@ -139,6 +140,7 @@
 
 #![warn(missing_docs)]
 
+pub mod baselines;
 pub mod derivatives;
 mod error;
 pub mod experiment;
