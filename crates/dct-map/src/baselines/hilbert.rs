@@ -34,11 +34,10 @@
 //! * Training points are capped at [`HilbertConfig::max_training_points`] (random subset):
 //!   the feature matrix is `M × N` reals.
 
-use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
-use faer::{Accum, ColMut, ColRef, Mat, MatMut, Par, Side};
+use faer::{ColMut, Mat, MatMut, MatRef, Par, Side};
 use rand::seq::index;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -135,23 +134,23 @@ impl NystromFeatures {
         self.landmarks.len()
     }
 
-    /// `k_M(x)` for each point, as the columns of an `M × n` matrix.
-    fn kernel_columns(&self, points: &[[f64; 2]]) -> Mat<f64> {
-        let mut k = Mat::<f64>::zeros(self.components(), points.len());
-        k.as_mut()
-            .par_col_iter_mut()
-            .zip(points)
-            .for_each(|(mut col, p)| {
-                for (i, z) in self.landmarks.iter().enumerate() {
-                    col[i] = rbf(distance_sq(*p, *z), self.gamma);
-                }
-            });
+    /// `k_M(x)` for each point, column-major `M × n` (point `j` at `j·M .. (j+1)·M`).
+    fn kernel_columns(&self, points: &[[f64; 2]]) -> Vec<f64> {
+        let m = self.components();
+        let mut k = vec![0.0; m * points.len()];
+        k.par_chunks_mut(m).zip(points).for_each(|(col, p)| {
+            for (c, z) in col.iter_mut().zip(&self.landmarks) {
+                *c = rbf(distance_sq(*p, *z), self.gamma);
+            }
+        });
         k
     }
 
     /// The features `φ(x) = L⁻¹ k_M(x)` of each point, as the columns of an `M × n` matrix.
     pub fn features(&self, points: &[[f64; 2]]) -> Mat<f64> {
-        let mut phi = self.kernel_columns(points);
+        let k = self.kernel_columns(points);
+        let mut phi =
+            MatRef::from_column_major_slice(&k, self.components(), points.len()).to_owned();
         solve_lower_triangular_in_place(self.chol.as_ref(), phi.as_mut(), Par::rayon(0));
         phi
     }
@@ -185,53 +184,91 @@ fn sigmoid(x: f64) -> f64 {
     }
 }
 
-/// Mean logistic loss + `(α/2)‖w‖²` of `x = (w, c)` on features `phi` (`M × N`), and its
-/// gradient; `z`, `r` are length-`N` scratch.
-fn logistic_objective(
-    phi: &Mat<f64>,
-    labels: &[f64],
+/// Training points per parallel task of the logistic objective.
+const COLUMNS_PER_TASK: usize = 512;
+
+/// The training data of the logistic fit in kernel form: `K_MN` (column-major, `k_M(x_j)` per
+/// point), the factor `L` of `K_MM + ε I` and the labels. The features `Φ = L⁻¹ K_MN` are
+/// never formed (`M²N` flops saved; two `M²` triangular solves per evaluation instead), and
+/// one pass over `K_MN` gives both the logits and the gradient.
+struct LogisticProblem<'a> {
+    kernel: &'a [f64],
+    chol: &'a Mat<f64>,
+    labels: &'a [f64],
     alpha: f64,
-    x: &[f64],
-    grad: &mut [f64],
-    z: &mut [f64],
-) -> f64 {
-    let (m, n) = (phi.nrows(), phi.ncols());
-    let (w, c) = (&x[..m], x[m]);
-    let mut zc = ColMut::from_slice_mut(z);
-    matmul(
-        zc.as_mut(),
-        Accum::Replace,
-        phi.transpose(),
-        ColRef::from_slice(w),
-        1.0,
-        Par::rayon(0),
-    );
-    let mut loss = 0.0;
-    let mut gc = 0.0;
-    // z becomes the per-point derivative of the mean loss w.r.t. the logit.
-    for (zi, y) in z.iter_mut().zip(labels) {
-        let margin = y * (*zi + c);
-        loss += softplus(-margin);
-        *zi = -y * sigmoid(-margin) / n as f64;
-        gc += *zi;
+}
+
+/// Dot product in eight lanes (vectorizable; fixed order, so deterministic).
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; 8];
+    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
+    let tail: f64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in ca.zip(cb) {
+        for k in 0..8 {
+            acc[k] += x[k] * y[k];
+        }
     }
-    let (gw, gb) = grad.split_at_mut(m);
-    let mut gcol = ColMut::from_slice_mut(gw);
-    matmul(
-        gcol.as_mut(),
-        Accum::Replace,
-        phi.as_ref(),
-        ColRef::from_slice(z),
-        1.0,
-        Par::rayon(0),
-    );
-    let mut penalty = 0.0;
-    for (g, w) in gw.iter_mut().zip(w) {
-        *g += alpha * w;
-        penalty += w * w;
+    acc.iter().sum::<f64>() + tail
+}
+
+impl LogisticProblem<'_> {
+    /// Mean logistic loss + `(α/2)‖w‖²` at `x = (w, c)`, and its gradient in `grad`.
+    fn evaluate(&self, x: &[f64], grad: &mut [f64]) -> f64 {
+        let m = self.chol.nrows();
+        let n = self.labels.len() as f64;
+        let (w, c) = (&x[..m], x[m]);
+        let (gw, gb) = grad.split_at_mut(m);
+        // v = L⁻ᵀ w, so that the logit of point j is k_M(x_j)ᵀ v + c = φ(x_j)ᵀ w + c.
+        gw.copy_from_slice(w);
+        solve_upper_triangular_in_place(
+            self.chol.transpose(),
+            ColMut::from_slice_mut(gw).as_mat_mut(),
+            Par::Seq,
+        );
+        let v: &[f64] = gw;
+        // Per task: loss, ∂/∂c, and u = Σ_j r_j k_M(x_j); summed in task order.
+        let parts: Vec<(f64, f64, Vec<f64>)> = self
+            .kernel
+            .par_chunks(m * COLUMNS_PER_TASK)
+            .zip(self.labels.par_chunks(COLUMNS_PER_TASK))
+            .map(|(block, ys)| {
+                let (mut loss, mut gc, mut u) = (0.0, 0.0, vec![0.0; m]);
+                for (col, y) in block.chunks_exact(m).zip(ys) {
+                    let margin = y * (dot(col, v) + c);
+                    loss += softplus(-margin);
+                    let r = -y * sigmoid(-margin) / n;
+                    gc += r;
+                    u.iter_mut().zip(col).for_each(|(u, k)| *u += r * k);
+                }
+                (loss, gc, u)
+            })
+            .collect();
+        let (mut loss, mut gc) = (0.0, 0.0);
+        gw.fill(0.0);
+        for (l, g, u) in &parts {
+            loss += l;
+            gc += g;
+            gw.iter_mut().zip(u).for_each(|(a, b)| *a += b);
+        }
+        // ∇_w = Φ r + α w = L⁻¹ u + α w.
+        solve_lower_triangular_in_place(
+            self.chol.as_ref(),
+            ColMut::from_slice_mut(gw).as_mat_mut(),
+            Par::Seq,
+        );
+        let mut penalty = 0.0;
+        for (g, w) in gw.iter_mut().zip(w) {
+            *g += self.alpha * w;
+            penalty += w * w;
+        }
+        gb[0] = gc;
+        loss / n + 0.5 * self.alpha * penalty
     }
-    gb[0] = gc;
-    loss / n as f64 + 0.5 * alpha * penalty
 }
 
 impl HilbertMap {
@@ -254,20 +291,21 @@ impl HilbertMap {
         picked.sort_unstable();
         let landmarks = picked.iter().map(|&i| set.points[i]).collect();
         let features = NystromFeatures::new(landmarks, config.gamma_per_m2, config.jitter)?;
-        let phi = features.features(&set.points);
+        let kernel = features.kernel_columns(&set.points);
         let m = features.components();
-        let mut z = vec![0.0; set.len()];
+        let problem = LogisticProblem {
+            kernel: &kernel,
+            chol: &features.chol,
+            labels: &set.labels,
+            alpha: config.regularization,
+        };
         let lbfgs = LbfgsConfig {
             max_iterations: config.max_iterations,
             memory: 10,
             gradient_tolerance: config.gradient_tolerance,
             relative_tolerance: 1e-12,
         };
-        let result = minimize(
-            |x, g| logistic_objective(&phi, &set.labels, config.regularization, x, g, &mut z),
-            vec![0.0; m + 1],
-            &lbfgs,
-        );
+        let result = minimize(|x, g| problem.evaluate(x, g), vec![0.0; m + 1], &lbfgs);
         let mut v = Mat::<f64>::from_fn(m, 1, |i, _| result.x[i]);
         let vm: MatMut<'_, f64> = v.as_mut();
         solve_upper_triangular_in_place(features.chol.transpose(), vm, Par::Seq);
