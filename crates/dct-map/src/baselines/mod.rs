@@ -45,7 +45,7 @@ use crate::{DctError, MapRay, Outcome};
 
 pub use gpom::{Gpom, GpomConfig, GpomReport};
 pub use hilbert::{HilbertConfig, HilbertMap, HilbertReport, NystromFeatures};
-pub use raster::{OCCUPANCY_CLAMP, OccupancyField, OccupancyRaster};
+pub use raster::{OCCUPANCY_CLAMP, OccupancyField, OccupancyRaster, RateAsOccupancy};
 
 /// How training points are drawn along rays (the rule of Ramos & Ott's published Hilbert-map
 /// code, used for both baselines).

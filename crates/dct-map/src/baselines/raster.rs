@@ -49,6 +49,26 @@ pub trait OccupancyField: Sync {
     fn occupancy(&self, points: &[[f64; 2]], out: &mut [f64]);
 }
 
+/// A decay-rate field `λ(x, y)` read as an occupancy field on pixels of edge `pixel_m`:
+/// `o = 1 − e^{−λ · pixel}`, the reflection probability of a subvoxel of that size
+/// (Eq. 7.27, `ln(1 − q) = −λ l`). Scoring a decay-rate map through this raster is the control
+/// that shows what the raster itself costs a map, apart from the map's quality.
+#[derive(Clone, Copy, Debug)]
+pub struct RateAsOccupancy<F> {
+    /// `λ` at a map-frame point (1/m).
+    pub rate_at: F,
+    /// Pixel edge (m).
+    pub pixel_m: f64,
+}
+
+impl<F: Fn([f64; 2]) -> f64 + Sync> OccupancyField for RateAsOccupancy<F> {
+    fn occupancy(&self, points: &[[f64; 2]], out: &mut [f64]) {
+        for (o, p) in out.iter_mut().zip(points) {
+            *o = -(-(self.rate_at)(*p) * self.pixel_m).exp_m1();
+        }
+    }
+}
+
 /// An occupancy field sampled at pixel centres, with the reflection-model ray likelihood.
 #[derive(Clone, Debug)]
 pub struct OccupancyRaster {
@@ -64,7 +84,7 @@ impl OccupancyRaster {
     pub fn from_field(
         extent_m: [f64; 2],
         pixel_m: f64,
-        field: &impl OccupancyField,
+        field: &(impl OccupancyField + ?Sized),
     ) -> Result<Self, DctError> {
         crate::error::positive("pixel_m", pixel_m)?;
         let grid = Grid2::new(Point2::origin(), pixel_m, cells_covering(extent_m, pixel_m))
@@ -268,6 +288,26 @@ mod tests {
                 *o = p[0] / 10.0;
             }
         }
+    }
+
+    /// A constant decay rate through the raster: a ray crossing whole pixels keeps exactly
+    /// the decay-rate model's `e^{−λ r}` (Eq. 7.27), a return differs from `λ e^{−λ r}` only by
+    /// the chord normalisation.
+    #[test]
+    fn constant_rate_as_occupancy_matches_the_decay_rate_model() {
+        let lambda = 0.7;
+        let field = RateAsOccupancy {
+            rate_at: |_: [f64; 2]| lambda,
+            pixel_m: 0.05,
+        };
+        let r = OccupancyRaster::from_field([1.0, 1.0], 0.05, &field).unwrap();
+        let pass = MapRay::from_angle([0.0, 0.52], 0.0, 1.0, Outcome::Super);
+        assert!((r.ray_log_likelihood(&pass) + lambda * 1.0).abs() < 1e-9);
+        let hit = MapRay::from_angle([0.0, 0.52], 0.0, 0.5 + 0.025, Outcome::Hit);
+        let q: f64 = -(-lambda * 0.05f64).exp_m1();
+        let want = (q / 0.05).ln() - lambda * 0.5;
+        assert!((r.ray_log_likelihood(&hit) - want).abs() < 1e-9);
+        assert!((want - (lambda.ln() - lambda * 0.525)).abs() < 1e-3);
     }
 
     #[test]
