@@ -16,14 +16,14 @@
 //!   classification (a probit of the LOO-calibrated latent). Its parameter vector is the
 //!   weight vector `(K + σ_n² I)⁻¹ y`, one real per training point, so equal memory means
 //!   **as many training points as parameters**, drawn at random from the sampled points
-//!   (the thesis "randomly downsample[s] the design matrix and the target vector").
+//!   (the thesis "randomly downsample the design matrix and the target vector").
 //! * **Hilbert maps** (Ramos & Ott 2016) with **Nyström features** of an RBF kernel:
 //!   logistic regression on `M` features, `M` = the number of parameters.
 //!
 //! ## Scoring rays
 //!
 //! Neither map has a forward model for a ray; the thesis rasterizes them with 0.05 m pixels,
-//! ray-traces and "cumulate[s] the occupancy probabilities along the rays". [`raster`] reads
+//! ray-traces and "cumulate the occupancy probabilities along the rays". [`raster`] reads
 //! that as the reflection model (Eq. 7.23) with the occupancy as reflection probability,
 //! turned into a density per metre like Eq. (7.25).
 //!
