@@ -11,7 +11,11 @@
 //!   are shuffled with ChaCha8 seeded by the seed, the first `mapping_rays` build the maps
 //!   and the next `held_back_rays` score them;
 //! * **ground truth**: the grid decay-rate map of 0.05 m cells (200 × 200 on 10 m) from the
-//!   mapping rays, evaluated at the centres of its observed cells (`R_i > 0`).
+//!   mapping rays, evaluated at the centres of its observed cells (`R_i > 0`);
+//! * **occupancy baselines** (Sec. 9.5.2, [`score_baseline`]): a GPOM with as many training
+//!   points and a Hilbert map with as many Nyström components as the DCT map has
+//!   coefficients, from the same mapping rays, scored on the held-back rays through a
+//!   [`BASELINE_PIXEL_M`] raster ([`crate::baselines`]).
 
 use std::time::Instant;
 
@@ -22,6 +26,10 @@ use rand_chacha::ChaCha8Rng;
 use raypath_geometry::{Grid2, Ray2};
 use serde::{Deserialize, Serialize};
 
+use crate::baselines::{
+    Gpom, GpomConfig, GpomReport, HilbertConfig, HilbertMap, HilbertReport, OccupancyField,
+    OccupancyRaster, TrainingConfig, TrainingSet,
+};
 use crate::render::p_ref;
 use crate::{
     DctError, DctMap, FitConfig, FitProblem, FitReport, GridRateMap, MapRay, Patch, RangeLimits,
@@ -258,6 +266,102 @@ pub fn compare(
         fit: report,
     };
     Ok((map, grid, comparison))
+}
+
+/// Pixel edge of the raster on which the occupancy baselines are scored (thesis Sec. 9.5.2).
+pub const BASELINE_PIXEL_M: f64 = 0.05;
+
+/// How the occupancy baselines of Sec. 9.5.2 are built (each field's docs give its default).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BaselineConfig {
+    /// Training points along the rays.
+    pub training: TrainingConfig,
+    /// GPOM hyperparameters.
+    pub gpom: GpomConfig,
+    /// Hilbert-map hyperparameters.
+    pub hilbert: HilbertConfig,
+}
+
+/// One occupancy baseline with `parameters` reals, scored on the held-back rays.
+#[derive(Clone, Debug)]
+pub struct BaselineScore {
+    /// Log-likelihood of the held-back rays on the [`BASELINE_PIXEL_M`] raster.
+    pub log_likelihood: f64,
+    /// Mapping time: training points from the rays, hyperparameters and fit (s).
+    pub fit_s: f64,
+    /// Time to predict the raster (s), not part of [`fit_s`](Self::fit_s).
+    pub raster_s: f64,
+    /// The raster (clamped occupancies).
+    pub raster: OccupancyRaster,
+}
+
+/// Which occupancy baseline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Baseline {
+    /// Gaussian process occupancy map, `parameters` training points.
+    Gpom,
+    /// Hilbert map, `parameters` Nyström components.
+    Hilbert,
+}
+
+/// The fit report of either baseline.
+#[derive(Clone, Debug, PartialEq)]
+pub enum BaselineReport {
+    /// GPOM.
+    Gpom(GpomReport),
+    /// Hilbert map.
+    Hilbert(HilbertReport),
+}
+
+/// Fits `which` with `parameters` reals from `mapping` (training points sampled with ChaCha8
+/// seeded by `seed`, the same stream then drawing the GPOM subset or the Nyström
+/// landmarks) and returns the fit time and the fitted field. Used for the timing runs.
+pub fn fit_baseline(
+    which: Baseline,
+    mapping: &[MapRay],
+    parameters: usize,
+    config: &BaselineConfig,
+    seed: u64,
+) -> Result<(f64, Box<dyn OccupancyField>, BaselineReport), DctError> {
+    let start = Instant::now();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let training = TrainingSet::sample(mapping, &config.training, &mut rng)?;
+    Ok(match which {
+        Baseline::Gpom => {
+            let (map, report) = Gpom::fit(&training, parameters, &config.gpom, &mut rng)?;
+            let t = start.elapsed().as_secs_f64();
+            (t, Box::new(map), BaselineReport::Gpom(report))
+        }
+        Baseline::Hilbert => {
+            let (map, report) = HilbertMap::fit(&training, parameters, &config.hilbert, &mut rng)?;
+            let t = start.elapsed().as_secs_f64();
+            (t, Box::new(map), BaselineReport::Hilbert(report))
+        }
+    })
+}
+
+/// [`fit_baseline`], then the [`BASELINE_PIXEL_M`] raster over `extent_m` and the
+/// log-likelihood of `held_back` on it ([`OccupancyRaster::log_likelihood`]).
+pub fn score_baseline(
+    which: Baseline,
+    extent_m: [f64; 2],
+    mapping: &[MapRay],
+    held_back: &[MapRay],
+    parameters: usize,
+    config: &BaselineConfig,
+    seed: u64,
+) -> Result<(BaselineScore, BaselineReport), DctError> {
+    let (fit_s, field, report) = fit_baseline(which, mapping, parameters, config, seed)?;
+    let start = Instant::now();
+    let raster = OccupancyRaster::from_field(extent_m, BASELINE_PIXEL_M, &*field)?;
+    let raster_s = start.elapsed().as_secs_f64();
+    let score = BaselineScore {
+        log_likelihood: raster.log_likelihood(held_back),
+        fit_s,
+        raster_s,
+        raster,
+    };
+    Ok((score, report))
 }
 
 /// A world ray from a map ray of `patch` (helper for callers that trace in the world frame).

@@ -64,6 +64,7 @@
 //! | [`GridRateMap`], [`initial_map`], [`DctMap::from_grid`], [`DctMap::to_rate_grid`] | the grid baseline (ch. 7) and conversions |
 //! | [`render`] | PNG of `p_ref = 1 − e^{−λ}` |
 //! | [`experiment`] | patch choice, ray draws, ground truth and the DCT-vs-grid comparison of Sec. 9.5 |
+//! | [`baselines`] | GPOM (Matérn) and Hilbert maps (Nyström) with as many parameters, and their rasterized ray likelihood (Sec. 9.5.2) |
 //!
 //! ## Defaults and where they come from
 //!
@@ -75,6 +76,10 @@
 //! | [`RangeLimits`] | `r_min = 0`, `r_max = ∞` | CARMEN logs have no `sub` readings; no-returns are decoded by the reader |
 //! | [`RIDGE_FACTOR`] | `δ = 1e-10 · max K_ii` | not in the thesis; numerical safeguard (below) |
 //! | [`PRIOR_PATH_DENSITY`] | `ρ = 1 /m` (prior `−ρ ∬ λ dx dy`) | not in ch. 9 (bare ML); the rate part of the gamma prior of Sec. 8.4.3, made continuous (below) |
+//! | [`baselines::GpomConfig`] | Matérn 3/2, `σ_f = 1`, `(ℓ, σ_n)` by marginal likelihood over `{0.2, 0.5, 1, 2} m × {0.1, 0.3, 1}` | thesis: Jadidi et al.'s settings, not listed; grid search on the mapping rays only |
+//! | [`baselines::HilbertConfig`] | RBF `γ = 1 /m²`, L2 `α = 1e-4`, ≤ 20 000 training points | Ramos & Ott's published code defaults (their SGD replaced by L-BFGS) |
+//! | [`baselines::TrainingConfig`] | one free point per 2 m of beam (≥ 1), 0.1 m off the return | Ramos & Ott's published code |
+//! | [`experiment::BASELINE_PIXEL_M`], [`baselines::OCCUPANCY_CLAMP`] | 0.05 m raster; occupancy clamped to `[1e-3, 1 − 1e-3]` | Sec. 9.5.2; the clamp is not in the thesis |
 //!
 //! ## Errata and decisions
 //!
@@ -139,6 +144,7 @@
 
 #![warn(missing_docs)]
 
+pub mod baselines;
 pub mod derivatives;
 mod error;
 pub mod experiment;
