@@ -13,6 +13,7 @@ use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use serde::{Deserialize, Serialize};
 
+use crate::lbfgs::{LbfgsConfig, Objective, minimize};
 use crate::{DctError, DctMap, FitProblem};
 
 /// The optimizer.
@@ -223,96 +224,47 @@ fn newton(
     Ok((a, report))
 }
 
+/// `−LL` of a [`FitProblem`] for the crate's L-BFGS minimizer: trials evaluate the
+/// log-likelihood alone, the gradient only at accepted points.
+struct NegativeLogLikelihood<'a>(&'a FitProblem);
+
+impl Objective for NegativeLogLikelihood<'_> {
+    const CHEAP_VALUE: bool = true;
+
+    fn value_gradient(&mut self, a: &[f64], grad: &mut [f64]) -> f64 {
+        let eval = self.0.evaluate(a);
+        grad.iter_mut()
+            .zip(&eval.gradient)
+            .for_each(|(g, e)| *g = -e);
+        -eval.log_likelihood
+    }
+
+    fn value(&mut self, a: &[f64], _scratch: &mut [f64]) -> f64 {
+        -self.0.log_likelihood(a)
+    }
+}
+
 fn lbfgs(
     p: &FitProblem,
     init: &[f64],
     config: &FitConfig,
 ) -> Result<(Vec<f64>, FitReport), DctError> {
-    let mut a = init.to_vec();
-    let mut eval = p.evaluate(&a);
-    check_start(eval.log_likelihood)?;
-    let mut report = FitReport {
-        iterations: 0,
-        log_likelihoods: vec![eval.log_likelihood],
-        evaluations: 1,
-        converged: false,
+    let settings = LbfgsConfig {
+        max_iterations: config.max_iterations,
+        memory: config.lbfgs_memory,
+        gradient_tolerance: 0.0,
+        relative_tolerance: config.relative_tolerance,
+        // The first step moves the coefficients by 0.1 % of their norm.
+        first_step_relative: Some(1e-3),
+    };
+    let result = minimize(&mut NegativeLogLikelihood(p), init.to_vec(), &settings);
+    check_start(-result.values[0])?;
+    let report = FitReport {
+        iterations: result.iterations(),
+        log_likelihoods: result.values.iter().map(|v| -v).collect(),
+        evaluations: result.evaluations,
+        converged: result.converged,
         seconds: 0.0,
     };
-    // Minimize f = −LL; gradient gf = −∇LL.
-    let mut gf: Vec<f64> = eval.gradient.iter().map(|g| -g).collect();
-    let mut memory: std::collections::VecDeque<(Vec<f64>, Vec<f64>, f64)> = Default::default();
-    while report.iterations < config.max_iterations {
-        // Two-loop recursion.
-        let mut q = gf.clone();
-        let mut alphas = Vec::with_capacity(memory.len());
-        for (s, y, rho) in memory.iter().rev() {
-            let al = rho * dot(s, &q);
-            q.iter_mut().zip(y).for_each(|(q, y)| *q -= al * y);
-            alphas.push(al);
-        }
-        let gamma = match memory.back() {
-            Some((s, y, _)) => dot(s, y) / dot(y, y),
-            None => {
-                let gn = dot(&gf, &gf).sqrt().max(1e-300);
-                1e-3 * dot(&a, &a).sqrt().max(1e-3) / gn
-            }
-        };
-        q.iter_mut().for_each(|q| *q *= gamma);
-        for ((s, y, rho), al) in memory.iter().zip(alphas.iter().rev()) {
-            let be = rho * dot(y, &q);
-            q.iter_mut().zip(s).for_each(|(q, s)| *q += (al - be) * s);
-        }
-        let dir: Vec<f64> = q.iter().map(|q| -q).collect();
-        let slope = dot(&gf, &dir);
-        if slope >= 0.0 {
-            memory.clear();
-            if report.iterations > 0 {
-                report.converged = true;
-                break;
-            }
-        }
-        let mut step = 1.0;
-        let mut accepted = None;
-        for _ in 0..40 {
-            let trial: Vec<f64> = a.iter().zip(&dir).map(|(a, d)| a + step * d).collect();
-            let ll = p.log_likelihood(&trial);
-            report.evaluations += 1;
-            // Armijo on f = −LL.
-            if ll.is_finite()
-                && -ll <= -eval.log_likelihood + 1e-4 * step * slope
-                && ll > eval.log_likelihood
-            {
-                accepted = Some(trial);
-                break;
-            }
-            step *= 0.5;
-        }
-        let Some(next) = accepted else {
-            report.converged = true;
-            break;
-        };
-        let old = eval.log_likelihood;
-        let next_eval = p.evaluate(&next);
-        report.evaluations += 1;
-        let gf_next: Vec<f64> = next_eval.gradient.iter().map(|g| -g).collect();
-        let s: Vec<f64> = next.iter().zip(&a).map(|(x, y)| x - y).collect();
-        let y: Vec<f64> = gf_next.iter().zip(&gf).map(|(x, y)| x - y).collect();
-        let sy = dot(&s, &y);
-        if sy > 1e-12 * dot(&y, &y).sqrt() * dot(&s, &s).sqrt() {
-            if memory.len() == config.lbfgs_memory.max(1) {
-                memory.pop_front();
-            }
-            memory.push_back((s, y, 1.0 / sy));
-        }
-        a = next;
-        eval = next_eval;
-        gf = gf_next;
-        report.iterations += 1;
-        report.log_likelihoods.push(eval.log_likelihood);
-        if relative_change(old, eval.log_likelihood) < config.relative_tolerance {
-            report.converged = true;
-            break;
-        }
-    }
-    Ok((a, report))
+    Ok((result.x, report))
 }

@@ -150,6 +150,7 @@ mod error;
 pub mod experiment;
 mod fit;
 mod grid;
+mod lbfgs;
 mod map;
 pub mod moments;
 mod objective;

@@ -34,10 +34,10 @@ use faer::{Mat, MatMut, Par, Side};
 use rand_chacha::ChaCha8Rng;
 use statrs::function::erf::erfc;
 
-use super::lbfgs::{LbfgsConfig, minimize};
 use super::raster::OccupancyField;
 use super::{TrainingSet, distance_sq, matern32};
 use crate::DctError;
+use crate::lbfgs::{LbfgsConfig, minimize};
 
 /// GPOM hyperparameters (module docs).
 #[derive(Clone, Debug, PartialEq)]
@@ -157,7 +157,7 @@ fn inverse_diagonal(l: &Mat<f64>) -> Vec<f64> {
 /// `(ln a, b)`, refined by L-BFGS.
 fn calibrate_squash(labels: &[f64], loo_mean: &[f64], loo_var: &[f64]) -> [f64; 2] {
     // Negative LOO pseudo-log-likelihood in (u = ln a, b) and its gradient.
-    let objective = |x: &[f64], g: &mut [f64]| {
+    let mut objective = |x: &[f64], g: &mut [f64]| {
         let (a, b) = (x[0].exp(), x[1]);
         let (mut f, mut gu, mut gb) = (0.0, 0.0, 0.0);
         for ((y, m), v) in labels.iter().zip(loo_mean).zip(loo_var) {
@@ -188,9 +188,10 @@ fn calibrate_squash(labels: &[f64], loo_mean: &[f64], loo_var: &[f64]) -> [f64; 
         memory: 5,
         gradient_tolerance: 1e-8,
         relative_tolerance: 1e-12,
+        first_step_relative: None,
     };
-    let r = minimize(objective, best.0.to_vec(), &config);
-    let x = if r.value <= best.1 {
+    let r = minimize(&mut objective, best.0.to_vec(), &config);
+    let x = if r.value() <= best.1 {
         r.x
     } else {
         best.0.to_vec()

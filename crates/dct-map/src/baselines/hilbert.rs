@@ -42,10 +42,10 @@ use rand::seq::index;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use super::lbfgs::{LbfgsConfig, minimize};
 use super::raster::OccupancyField;
 use super::{TrainingSet, distance_sq, rbf};
 use crate::DctError;
+use crate::lbfgs::{LbfgsConfig, minimize};
 
 /// Hilbert-map hyperparameters (module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -304,17 +304,19 @@ impl HilbertMap {
             memory: 10,
             gradient_tolerance: config.gradient_tolerance,
             relative_tolerance: 1e-12,
+            first_step_relative: None,
         };
-        let result = minimize(|x, g| problem.evaluate(x, g), vec![0.0; m + 1], &lbfgs);
+        let mut objective = |x: &[f64], g: &mut [f64]| problem.evaluate(x, g);
+        let result = minimize(&mut objective, vec![0.0; m + 1], &lbfgs);
         let mut v = Mat::<f64>::from_fn(m, 1, |i, _| result.x[i]);
         let vm: MatMut<'_, f64> = v.as_mut();
         solve_upper_triangular_in_place(features.chol.transpose(), vm, Par::Seq);
         let report = HilbertReport {
             components: m,
             training_points: set.len(),
-            iterations: result.iterations,
+            iterations: result.iterations(),
             converged: result.converged,
-            objective: result.value,
+            objective: result.value(),
         };
         let map = Self {
             v: (0..m).map(|i| v[(i, 0)]).collect(),

@@ -34,7 +34,6 @@
 
 pub mod gpom;
 pub mod hilbert;
-mod lbfgs;
 pub mod raster;
 
 use rand::Rng;
