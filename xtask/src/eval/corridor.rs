@@ -1,4 +1,4 @@
-//! The 1-D corridor simulation of Schaefer ch. 8 (Sec. 8.5.1, spec §4.8): belief at the
+//! The 1-D corridor simulation of Schaefer ch. 8 (Sec. 8.5.1): belief at the
 //! true pose for MLM, FMP with uniform prior and FMP with conjugate prior; a section of
 //! `eval mcl`.
 //!
@@ -9,22 +9,23 @@
 //! * **Filter**: an exact Bayes filter over the 100 voxels. The belief starts uniform; at
 //!   iteration `t = 0 … 99` the robot is in voxel `t`. From `t = 1` on the belief is shifted by
 //!   one voxel (known motion; the mass pushed past the last voxel is dropped and the rest
-//!   renormalized, spec §4.8 (c)), then multiplied by the likelihood of the observation under
-//!   each hypothesis `x` — evaluated with the map of voxel `x` (§4.8 (b)) — and normalized.
-//! * **ρ** = mean over the 100 iterations of the belief at the true voxel (§4.8 (d)).
-//! * **Likelihoods** (spec §4.6): REF FMP `l = (H+α)^δ (M+β)^{1−δ} / (H+α+M+β)` (Eq. 8.22),
+//!   renormalized — the thesis leaves the border open), then multiplied by the likelihood of
+//!   the observation under each hypothesis `x`, evaluated with the map of voxel `x`, and
+//!   normalized.
+//! * **ρ** = mean over the 100 iterations of the belief at the true voxel.
+//! * **Likelihoods** (Sec. 8.4.5): REF FMP `l = (H+α)^δ (M+β)^{1−δ} / (H+α+M+β)` (Eq. 8.22),
 //!   REF MLM `l = μ^δ (1−μ)^{1−δ}`, DEC FMP `l = ((R+β)/(R+β+r))^{H+α} ((H+α)/(R+β+r))^δ`,
 //!   DEC MLM `l = λ^δ e^{−λ r}`.
-//! * **MLM zero likelihoods** (§4.8 (e)): MLM clamps the ML values to `μ ∈ [1e-12, 1 − 1e-12]`
+//! * **MLM zero likelihoods** (the thesis does not say how its MLM survives a zero): MLM clamps the ML values to `μ ∈ [1e-12, 1 − 1e-12]`
 //!   and `λ ≥ 1e-12 /m` (a zero likelihood stays practically zero, as in the thesis's MLM,
 //!   but the filter stays defined). MLM-clamped, reported beside, uses the clamps of the
-//!   crate's models (spec A3): `μ ∈ [1e-3, 1 − 1e-3]` ([`ReflectionConfig`] default) and
+//!   crate's models (which floor λ and μ so that an unhit voxel does not give −∞): `μ ∈ [1e-3, 1 − 1e-3]` ([`ReflectionConfig`] default) and
 //!   `λ ≥ 1e-3 /m` ([`DecayRateConfig`] default). How often the unclamped ML likelihood at
 //!   the true voxel was zero is reported.
 //! * **Priors**: FMP-uniform uses Beta(1, 1) (REF) and the flat Gamma(1, 0) (DEC, improper;
 //!   every voxel is visited at least once, so `R + β > 0`); FMP-conjugate estimates α, β per
 //!   run by the method of moments over the ML map ([`BetaPrior::estimate`],
-//!   [`GammaPrior::estimate`]; spec §4.7, A9).
+//!   [`GammaPrior::estimate`]; Sec. 8.5, over the voxels with a finite ML value).
 //! * **Test**: one-tailed paired t-test of `ρ_conj − ρ_other` over the runs (H1: mean > 0).
 
 use anyhow::Result;
@@ -59,7 +60,7 @@ enum Algorithm {
     /// ML map, μ clamped to [1e-12, 1 − 1e-12] / λ ≥ 1e-12: a zero likelihood stays
     /// (practically) zero — the thesis's MLM.
     Mlm,
-    /// ML map with the crate's model clamps (1e-3, spec A3).
+    /// ML map with the crate's model clamps (1e-3).
     MlmClamped,
     FmpUniform,
     FmpConjugate,
@@ -180,7 +181,7 @@ impl VoxelLikelihood {
                     return 0.0;
                 }
                 let denominator = b + obs.distance_m;
-                let survive = (a * (b / denominator).ln()).exp(); // spec §4.6, l_dec FMP
+                let survive = (a * (b / denominator).ln()).exp(); // Sec. 8.4.5, l_dec FMP
                 if obs.hit {
                     survive * a / denominator
                 } else {
@@ -354,7 +355,7 @@ pub fn section(ctx: &EvalContext) -> Result<(String, serde_json::Value)> {
         "corridor",
     );
     let mut markdown = format!(
-        "Simulated (Schaefer 2020 Sec. 8.5.1, spec §4.8): a corridor of 100 voxels, ground truth \
+        "Simulated (Schaefer 2020 Sec. 8.5.1): a corridor of 100 voxels, ground truth \
          re-drawn per run (REF μ ~ U(0, 1), DEC λ ~ Gamma(1, 1)), {runs} seeded runs per n \
          (thesis: 10 000), seed {SEED}. ρ = belief at the true voxel averaged over the 100 \
          iterations of an exact Bayes filter with known motion and a uniform initial belief. \
@@ -362,8 +363,8 @@ pub fn section(ctx: &EvalContext) -> Result<(String, serde_json::Value)> {
          t-test (H1: FMP-conjugate better). Thesis (Fig. 8.2): FMP-conjugate better than both \
          with p < 1e-4 for n ≤ 100 (REF) and n ≤ 4 (DEC). MLM (the thesis's) uses the ML map with \
          μ clamped to [1e-12, 1 − 1e-12] and λ ≥ 1e-12 /m, so a zero likelihood stays practically \
-         zero but the filter stays defined (spec §4.8 (e)); MLM-clamped uses the clamps of the \
-         crate's models instead (μ ∈ [1e-3, 1 − 1e-3], λ ≥ 1e-3 /m, spec A3) and is shown beside. \
+         zero but the filter stays defined; MLM-clamped uses the clamps of the \
+         crate's models instead (μ ∈ [1e-3, 1 − 1e-3], λ ≥ 1e-3 /m) and is shown beside. \
          \"ML zeros\" = observations per run whose unclamped ML likelihood at the true voxel is 0; \
          each one nearly removes the true pose from the MLM belief.\n\n"
     );

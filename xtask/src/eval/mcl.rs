@@ -301,7 +301,7 @@ The simulated indoor maps are built from the corrected (noise-free pose) log of 
 the even frames only, localization on the odd ones (disjoint, as in the thesis).
 - **Likelihood exponent**: full-scan likelihoods are far too peaked (Eq. 7.15 treats beams as independent); every \
 model is tempered the same way, `ln p̃ = γ Σ ln p(z_j)` with γ = 8 / (kept beams) (`raypath_localizer::lidar`). \
-The thesis does not say how it kept its filters healthy (erratum A4).
+The thesis does not say how it kept its filters healthy (motion model, resampling, estimator and rays per scan are not given in Sec. 7.5).
 - **Outlier beams**: every beam of every model is mixed with a random reading, `p̃ = (1 − ε) p + ε q` with ε = 0.05 (AMCL's `z_rand`; `q` = no-return or uniform return on [0, r_max), each with probability ½), because the ray-casting models have no false-detection term and a single no-return through glass or unmapped space otherwise costs tens to hundreds of nats (`LidarConfig::random_weight`). The runs that still diverge start with the initial mean 1.6–2.4 m from the truth and never converge: with 300 particles no particle reaches the narrow basin of the ray-casting likelihoods (on intel, decay-rate started with the mean at the truth converged in 10/10 runs even without the mixture).
 - **Filter**: systematic resampling when ESS / N < 0.5, estimate = mean of the best 10 % of the particles, 2-D \
 updates after 0.2 m / 0.2 rad of odometry and at every scan with ground truth, errors evaluated \

@@ -11,7 +11,7 @@
 //!   pipeline asks for them, nothing is written to disk.
 //! * Second table (full run only), **urban-nclt**: `datasets/generated/urban-nclt`, four
 //!   sessions through a procedural street grid (NCLT layout on disk).
-//! * Map (spec §3.2, `ncltpoles.py`): local maps every 1.5 m over 1.5 m along the ground
+//! * Map (Schaefer 2020 Sec. 12.3, the reference code's `ncltpoles.py`): local maps every 1.5 m over 1.5 m along the ground
 //!   truth; session 1 contributes all of them, later sessions only the local maps centred
 //!   ≥ 10 m from every pose of the earlier sessions (`f_map` = fraction of a session's local
 //!   maps added); the map keeps the overlap clusters with ≥ 3 detections.

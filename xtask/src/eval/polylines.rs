@@ -484,7 +484,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     let mut md = String::new();
     let _ = writeln!(
         md,
-        "Schaefer (2020) ch. 10 / spec §1.7: RMSE of the ray radii, fraction f of reflected \
+        "Schaefer (2020) ch. 10 (experiments, Table 10.1): RMSE of the ray radii, fraction f of reflected \
          rays explained, area error a and IoU (simulation), time per scan; mean ± standard \
          error over scans. PLE+ uses Levenberg–Marquardt (crate default); PLE+ (NM) is the \
          thesis' Nelder–Mead (fminsearch options TolX = TolFun = 1e-2, 200·dim iterations). \

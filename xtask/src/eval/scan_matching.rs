@@ -78,8 +78,8 @@ const ANCHOR_COMPARABLE: &str = "no — same real log, but ours over consecutive
      recalled, not re-checked";
 
 /// Kümmerle et al. (2009) relative-motion errors (translation m mean ± std, rotation °
-/// mean ± std) for scan matching and graph-based SLAM, as recalled (issue 10 recalls the
-/// Intel scan-matching row as ≈ 0.22 ± 0.30 m); not checked against the paper here.
+/// mean ± std) for scan matching and graph-based SLAM, as recalled (the Intel
+/// scan-matching row as ≈ 0.22 ± 0.30 m); not checked against the paper here.
 const ANCHORS: [(&str, &str, &str); 3] = [
     (
         "intel",
@@ -668,7 +668,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     let mut md = String::new();
     let _ = writeln!(
         md,
-        "Khan (2017) ch. 3, spec §3: Hector-style multi-resolution scan matching (3 levels, \
+        "Khan (2017) ch. 3: Hector-style multi-resolution scan matching (3 levels, \
          finest 5 cm, update factors 0.4 / 0.9, 3 + 3 + 5 Gauss–Newton iterations, map updates \
          after 0.4 m or 0.9 rad) with occupancy, reflectivity or combined residuals; intensity \
          calibration by LUT. Release build, one thread; the machine was shared with other jobs, \

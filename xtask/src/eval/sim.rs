@@ -348,7 +348,7 @@ fn comparison_table(sets: &[SetOnDisk], ctx: &EvalContext) -> Result<Table> {
                 "simulated rays per second (2 cores)".into(),
                 format!("{:.2e}", s.num("rays_per_s")),
                 "≥ 2e6 (aim)".into(),
-                "issue 3".into(),
+                "raypath's own aim".into(),
                 comparable::no("an aim, not a thesis or peer figure"),
             ]);
         }

@@ -96,7 +96,7 @@ pub(super) fn report_markdown(
     let mut md = String::new();
     let _ = writeln!(
         md,
-        "Schaefer (2020) ch. 9 / spec §5.6. Per log: one 10 m × 10 m patch drawn with seed {SEED} \
+        "Schaefer (2020) Sec. 9.5. Per log: one 10 m × 10 m patch drawn with seed {SEED} \
          among the candidate patches (1 m lattice of corners) with at least {:.0} % of the largest \
          ray path length; all rays reaching it are clipped to it, shuffled (ChaCha8, seed {SEED}); \
          the first {MAPPING_RAYS} build the maps, the next {HELD_BACK} are held back. Ground truth: \

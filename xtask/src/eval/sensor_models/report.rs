@@ -341,7 +341,7 @@ pub fn markdown(sets: &[DataSet], plan: &str, notes: &[String]) -> Result<String
          0.2–0.4 m from the truth, so `ĝ` is practically one-hot on it, and every bit of model \
          probability on a sample at distance d costs about d²/(2σ²) nats (50 nats at 0.5 m): \
          our inverse KL values are tens to hundreds of nats where the thesis prints 1–5. The \
-         thesis does not state its σ for Table 7.3 (spec A6 takes ch. 8's 0.05 m); the \
+         thesis does not state its σ for Table 7.3 (we take ch. 8's 0.05 m); the \
          orderings are what we compare.\n",
     );
 
