@@ -27,7 +27,9 @@ pub struct SubmapConfig {
     /// Before Gauss–Newton, the heading is searched within ± this window (radians) around the
     /// odometry guess on the coarsest grid (0: off). Default 0.2 rad: the odometry heading
     /// errors between scans of the benchmark logs reach several degrees, beyond the
-    /// Gauss–Newton basin at 10 m range (ours).
+    /// Gauss–Newton basin at 10 m range (ours). An increment that turns beyond the window
+    /// (or moves more than two coarsest cells) also has the last pose searched as a second
+    /// guess, against odometry jumps.
     pub rotation_window_rad: f64,
     /// Step of that search, radians. Default 1°.
     pub rotation_step_rad: f64,

@@ -72,14 +72,31 @@ impl FrontEnd {
                 let submap_from_local = submap.local_from_submap.inverse();
                 let mut initial = submap_from_local * guess;
                 if self.rotation_window_rad > 0.0 {
-                    initial = rotation_search(
-                        submap.map.levels(),
-                        points,
-                        initial,
-                        self.rotation_window_rad,
-                        self.rotation_step_rad,
-                        self.rotation_min_gain,
-                    );
+                    let search = |start: Pose2| {
+                        rotation_search(
+                            submap.map.levels(),
+                            points,
+                            start,
+                            self.rotation_window_rad,
+                            self.rotation_step_rad,
+                            self.rotation_min_gain,
+                        )
+                    };
+                    let (from_odometry, score) = search(initial);
+                    initial = from_odometry;
+                    // A glitch in the odometry (a jump in the log, wheel slip) moves the guess
+                    // out of every basin: when the increment turns beyond the search window
+                    // or moves more than two coarsest cells, the pose of the last scan (no
+                    // motion) is a second candidate, taken when it scores clearly better.
+                    let coarsest = submap.map.levels().last().map_or(0.0, |l| l.resolution_m());
+                    if delta.theta().abs() > self.rotation_window_rad
+                        || delta.translation().norm() > 2.0 * coarsest
+                    {
+                        let (standing, standing_score) = search(submap_from_local * self.local);
+                        if standing_score > score + self.rotation_min_gain {
+                            initial = standing;
+                        }
+                    }
                 }
                 let prior = self.matcher.odometry_sigma.map(|s| Prior {
                     pose: initial,
@@ -174,7 +191,7 @@ impl FrontEnd {
 /// best on the coarsest level (mean bilinear occupancy of every 4th point; position kept), when
 /// it beats the guess's score by at least `min_gain`: a correlative search over rotation only,
 /// which brings large odometry heading errors into the Gauss–Newton basin (Olson 2009's idea,
-/// restricted to one axis) and leaves good guesses alone.
+/// restricted to one axis) and leaves good guesses alone. Returns the pose and its score.
 fn rotation_search(
     levels: &[GridLevel],
     points: &ScanPoints,
@@ -182,9 +199,9 @@ fn rotation_search(
     window: f64,
     step: f64,
     min_gain: f64,
-) -> Pose2 {
+) -> (Pose2, f64) {
     let Some(grid) = levels.last() else {
-        return initial;
+        return (initial, 0.0);
     };
     let score = |theta: f64| {
         let (c, s) = (theta.cos(), theta.sin());
@@ -209,7 +226,12 @@ fn rotation_search(
             best = (v, theta);
         }
     }
-    Pose2::new(initial.x(), initial.y(), best.1)
+    let score = if best.1 == initial.theta() {
+        at_guess
+    } else {
+        best.0
+    };
+    (Pose2::new(initial.x(), initial.y(), best.1), score)
 }
 
 /// Freezes finished submaps with the branch-and-bound depth of `config`.

@@ -179,3 +179,31 @@ fn bad_scans_are_errors_not_panics() {
         .is_err()
     );
 }
+
+/// Jumps in the odometry (as the raw MIT CSAIL log has: 0.5–0.9 m and 30–50° between two
+/// scans 0.2 s apart) do not break the front-end: the pose of the last scan is tried as a
+/// second guess, so the trajectory stays as good as without the jumps.
+#[test]
+fn odometry_jumps_do_not_break_the_front_end() {
+    let truth = path(1);
+    let clean = odometry(&truth, 0.03);
+    let mut jumped = vec![clean[0]];
+    for (k, w) in clean.windows(2).enumerate() {
+        let mut d = w[0].inverse() * w[1];
+        if [40, 150, 400].contains(&k) {
+            d = d * Pose2::new(0.8, -0.3, 0.8);
+        }
+        let last = *jumped.last().unwrap();
+        jumped.push(last * d);
+    }
+    let open = SlamConfig {
+        loops: None,
+        ..SlamConfig::default()
+    };
+    let e_clean = max_error(&truth, &run(open.clone(), &truth, &clean).world_from_sensor);
+    let e_jumped = max_error(&truth, &run(open, &truth, &jumped).world_from_sensor);
+    assert!(
+        e_jumped < e_clean + 0.1,
+        "with jumps {e_jumped} m, without {e_clean} m"
+    );
+}
