@@ -172,9 +172,12 @@ pub fn check_loops(
 /// Self-consistency of a map without reference poses: of the confidently occupied cells of
 /// each finished submap (log-odds > 2, finest level) that fall, at the optimised submap poses,
 /// on confidently observed cells of another submap that shares no node with it, the fraction
-/// that the other submap holds confidently **free** (log-odds < −2). Walls seen through free
+/// that the other submap holds confidently **free** (log-odds < −2) with none of its own
+/// confidently occupied cells within [`DISAGREEMENT_TOLERANCE_M`]. Walls seen through free
 /// space of another visit are what a broken loop (or a missed one) leaves behind; a
-/// consistent map scores close to 0. Returns `(fraction, cells compared)`.
+/// consistent map scores close to 0. The tolerance keeps a wall drawn one or two cells
+/// thicker or thinner by the other visit (5 cm cells) from counting. Returns
+/// `(fraction, cells compared)`.
 pub fn submap_disagreement(output: &crate::SlamOutput) -> (f64, usize) {
     const CONFIDENT: f32 = 2.0;
     let submaps = &output.submaps;
@@ -185,6 +188,7 @@ pub fn submap_disagreement(output: &crate::SlamOutput) -> (f64, usize) {
             continue;
         };
         let (res, o) = (la.resolution_m(), la.origin());
+        let near = (DISAGREEMENT_TOLERANCE_M / res).round() as usize;
         for (b, sb) in submaps.iter().enumerate() {
             let (Some(world_from_b), Some(lb)) = (pose(sb), sb.levels().first()) else {
                 continue;
@@ -215,7 +219,7 @@ pub fn submap_disagreement(output: &crate::SlamOutput) -> (f64, usize) {
                     let l = lb.log_odds(bi, bj);
                     if l.abs() > CONFIDENT {
                         compared += 1;
-                        if l < -CONFIDENT {
+                        if l < -CONFIDENT && !occupied_near(lb, (bi, bj), near, CONFIDENT) {
                             conflicts += 1;
                         }
                     }
@@ -229,6 +233,23 @@ pub fn submap_disagreement(output: &crate::SlamOutput) -> (f64, usize) {
         conflicts as f64 / compared as f64
     };
     (fraction, compared)
+}
+
+/// How far a wall of one submap may lie from the other submap's wall on the same spot before
+/// [`submap_disagreement`] counts it: 0.15 m (three 5 cm cells; ours).
+pub const DISAGREEMENT_TOLERANCE_M: f64 = 0.15;
+
+/// Whether a cell within `near` cells (Chebyshev) of `cell` has log-odds above `confident`.
+fn occupied_near(
+    level: &raypath_reflectivity::GridLevel,
+    (i, j): (usize, usize),
+    near: usize,
+    confident: f32,
+) -> bool {
+    let (w, h) = (level.width(), level.height());
+    (j.saturating_sub(near)..=(j + near).min(h - 1)).any(|y| {
+        (i.saturating_sub(near)..=(i + near).min(w - 1)).any(|x| level.log_odds(x, y) > confident)
+    })
 }
 
 /// For scans without a reference pose, a reference **by neighbour**: the nearest referenced

@@ -3,7 +3,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // test code: a panic is the failure report
 
 use raypath_geometry::{Pose2, Scan2};
-use raypath_slam::benchmark::loop_error;
+use raypath_slam::benchmark::{loop_error, submap_disagreement};
 use raypath_slam::{Slam, SlamConfig, SlamOutput};
 
 type Segment = ([f64; 2], [f64; 2]);
@@ -205,5 +205,24 @@ fn odometry_jumps_do_not_break_the_front_end() {
     assert!(
         e_jumped < e_clean + 0.1,
         "with jumps {e_jumped} m, without {e_clean} m"
+    );
+}
+
+/// The self-consistency measure of the large-loop logs: low for a closed loop, high once the
+/// second lap is moved off the first by 0.4 m and 3°.
+#[test]
+fn submap_disagreement_sees_a_broken_loop() {
+    let truth = path(2);
+    let mut out = run(SlamConfig::default(), &truth, &odometry(&truth, 0.03));
+    let (consistent, compared) = submap_disagreement(&out);
+    assert!(compared > 1000, "{compared} cells compared");
+    let half = out.nodes.len() / 2;
+    for p in &mut out.nodes[half..] {
+        *p = Pose2::new(0.4, 0.0, 0.05) * *p;
+    }
+    let (inconsistent, _) = submap_disagreement(&out);
+    assert!(
+        consistent < 0.05 && inconsistent > 4.0 * consistent.max(0.02),
+        "closed loop {consistent}, broken {inconsistent}"
     );
 }
