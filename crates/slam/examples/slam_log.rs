@@ -62,6 +62,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if env("SLAM_NO_INTRA").is_some() {
         config.intra_submap_edges = false;
     }
+    if let Some(w) = env("SLAM_REJECT") {
+        config.reject_weight = w;
+    }
     if let Some(n) = env("SLAM_NODES") {
         config.submaps.nodes_per_submap = n as usize;
     }
@@ -131,10 +134,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 if *t > 0.15 || r.to_degrees() > 1.5 {
                     let (a, b) = (out.node_scan[c.anchor], out.node_scan[c.node]);
                     println!(
-                        "loop {a}->{b} {:?} score {:.3} error {t:.3} m {:.2}°",
+                        "loop {a}->{b} {:?} score {:.3} error {t:.3} m {:.2}° weight {:.3} chi2 {:.1}",
                         c.source,
                         c.score,
-                        r.to_degrees()
+                        r.to_degrees(),
+                        out.graph.edge_weight(c.edge),
+                        out.graph.edge_chi2(c.edge)
                     );
                 }
             }
