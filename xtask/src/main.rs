@@ -10,12 +10,15 @@
 //!                                         feed every raypath-io reader N mutated inputs
 //!                                         (default 100000); fail on a panic, hang or an
 //!                                         error that does not name the file and place
+//! cargo xtask check-layers                no crate depends on a higher layer than its own
+//!                                         (layers from docs/architecture.md)
 //! ```
 
 mod datasets;
 mod eval;
 mod fuzz;
 mod generate;
+mod layers;
 mod readme;
 mod render;
 mod stats;
@@ -56,6 +59,9 @@ enum Command {
     /// and `Ok` or an error naming the file and place. Prints a table of counts; fails on a
     /// panic, hang or bad error, saving its input to `target/fuzz/<reader>-<case>.bin`.
     Fuzz(fuzz::FuzzOptions),
+    /// Check that no crate depends on a crate of a higher layer (layers from the crate table
+    /// of docs/architecture.md, dependencies from `cargo metadata`); every crate must be listed.
+    CheckLayers,
 }
 
 #[derive(Subcommand)]
@@ -85,5 +91,8 @@ fn main() -> Result<()> {
             }
         },
         Command::Fuzz(options) => fuzz::run(&options),
+        Command::CheckLayers => {
+            layers::run(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        }
     }
 }
