@@ -9,14 +9,14 @@
 //! neighbours and always executes the create/extend/merge action that raises the error
 //! least, until the least increment exceeds `e` ([`PpeParams`]).
 //!
-//! * [`extract`] / [`extract_grid`]: PPE on an organized cloud ([`ppe`]).
-//! * [`fit_plane`]: the exact radial least-squares plane ([`fit`]); [`PlaneStats`]: its
-//!   additive sufficient statistics used for the clustering decisions ([`stats`]).
+//! * [`extract`] / [`extract_grid`]: PPE on an organized cloud; [`TETROMINOES`]: its seeds.
+//! * [`fit_plane`]: the exact radial least-squares plane ([`refine`]: by Gauss–Newton from a
+//!   start); [`PlaneStats`]: its additive sufficient statistics used for the clustering
+//!   decisions.
 //! * [`compare`]: the Hoover et al. protocol with `T = 0.8`, k-value and angle deviation
-//!   ([`hoover`]).
-//! * [`msac()`](fn@msac): the iterative MSAC baseline (module [`mod@msac`]).
-//! * [`peac()`](fn@peac): the PEAC-style block-graph AHC baseline of Feng et al. (2014)
-//!   (module [`mod@peac`]).
+//!   ([`angle_deviation`], [`folded_angle_deg`]).
+//! * [`msac`]: the iterative MSAC baseline.
+//! * [`peac`]: the PEAC-style block-graph AHC baseline of Feng et al. (2014).
 //! * [`PpeParams::synpeb`], [`PpeParams::segcomp`]: presets of the two benchmarks.
 //!
 //! Decisions beyond the thesis: the presets `synpeb-<σ>` enable a post-processing of the
@@ -57,21 +57,22 @@
 //! assert!(seg.rmse_m() < 1e-6);
 //! ```
 
-pub mod error;
-pub mod fit;
-pub mod hoover;
-pub mod msac;
-pub mod params;
-pub mod peac;
-pub mod ppe;
-pub mod stats;
-pub mod tetromino;
+mod error;
+mod fit;
+mod hoover;
+mod msac;
+mod params;
+mod peac;
+mod ppe;
+mod stats;
+mod tetromino;
 
 pub use error::PlaneError;
-pub use fit::{PlaneFit, fit_plane, radial_sse};
-pub use hoover::{HooverParams, HooverResult, compare};
+pub use fit::{PlaneFit, fit_plane, radial_sse, refine};
+pub use hoover::{HooverParams, HooverResult, angle_deviation, compare, folded_angle_deg};
 pub use msac::{MsacParams, msac};
 pub use params::PpeParams;
 pub use peac::{PeacParams, peac};
 pub use ppe::{Plane, Segmentation, extract, extract_grid};
 pub use stats::PlaneStats;
+pub use tetromino::TETROMINOES;

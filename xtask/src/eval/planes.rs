@@ -8,7 +8,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use nalgebra::Vector3;
 use raypath_geometry::PointCloud;
-use raypath_planes::hoover::angle_deviation;
+use raypath_planes::angle_deviation;
 use raypath_planes::{
     HooverParams, MsacParams, PeacParams, PpeParams, Segmentation, compare, extract,
 };

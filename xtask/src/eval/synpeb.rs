@@ -3,7 +3,7 @@
 //! beside Table 11.1 of Schaefer (2020). PPE runs with the preset of each noise level
 //! (`PpeParams::preset("synpeb-<σ>")`, grid-searched on the training split).
 //!
-//! Metrics per scan (Hoover et al. with T = 0.8, `raypath_planes::hoover`): f, k, per-ray
+//! Metrics per scan (Hoover et al. with T = 0.8, `raypath_planes::compare`): f, k, per-ray
 //! radial RMSE of the extracted planes (planes with RMSE ≥ 10 m excluded; Eq. 11.6 divides by the
 //! number of planes, but the thesis' millimetre figures are per-ray values, so per ray here),
 //! n_o, n_u, n_m, n_s and the extraction time; means over the scans of a split. The RMSE is
