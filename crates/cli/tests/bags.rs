@@ -295,6 +295,33 @@ fn planar_commands_read_a_bag_like_the_log() {
         b["candidates"].as_array().unwrap().len()
     );
 
+    // slam: the bag maps like the log (same scans and nodes, the same trajectory up to the
+    // float32 ranges), with the bag's poses as ground truth; outputs in --out.
+    let slam_of = |input: &Path, out: &str| {
+        json_of(&raypath(&[
+            "slam",
+            s(input),
+            "--out",
+            s(&d.join(out)),
+            "--ground-truth",
+            s(input),
+            "--json",
+        ]))
+    };
+    let (a, b) = (slam_of(&log, "slam-log"), slam_of(&bag, "slam-bag"));
+    assert_eq!(b["scans"], SCANS);
+    for key in ["scans", "nodes", "paired_scans"] {
+        assert_eq!(a[key], b[key], "{key}");
+    }
+    let (x, y) = (
+        &a["summary"]["trans_error_m"],
+        &b["summary"]["trans_error_m"],
+    );
+    assert!(close(x, y, 1e-3), "{x} vs {y}");
+    assert!(y.as_f64().unwrap() < 0.05, "{b}");
+    assert!(d.join("slam-bag/trajectory.txt").exists());
+    assert!(d.join("slam-bag/map.pgm").exists());
+
     // A topic the bag does not have is bad input naming it.
     let out = raypath(&["polylines", s(&bag), "--scan-topic", "/nope"]);
     assert_eq!(out.status.code(), Some(2));
