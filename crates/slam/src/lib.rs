@@ -49,7 +49,7 @@
 //!   cells (0.4 m) between two scans, the last scan's pose (no motion) is searched as a second
 //!   guess and taken when it scores clearly better: the raw MIT CSAIL log has odometry jumps
 //!   of 0.5–0.9 m and 20–50° within 0.2 s, which used to throw the front-end out of the map
-//!   for good (random-pair error 13.7 m; see `docs/results/slam.md`).
+//!   for good (the mit-csail rows of `docs/results/slam.md` show the log now).
 //! * Loop search from every third node against the three nearest finished submaps within
 //!   10 m (+ 2 % of the path since the last loop closure), windows ±1.5 m / ±20°, and one
 //!   place-recognition candidate over ±π; minimum branch-and-bound score 0.55 (Hess et al.'s
