@@ -6,6 +6,8 @@
 //! raypath simulate <kind> --out DIR [--seed S] [--quick] [--scans N] [--json]
 //! raypath simulate semi-kitti --poses poses.txt --times times.txt --poles poles.csv --out DIR
 //! raypath register <source> <target> | <sequence> [--json]
+//! raypath completions bash|zsh|fish|elvish|powershell
+//! raypath man [--out DIR]
 //! ```
 //!
 //! Every subcommand prints a human-readable report, or with `--json` one JSON document on
@@ -17,7 +19,7 @@ mod commands;
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 
 #[derive(Parser)]
 #[command(
@@ -85,6 +87,11 @@ enum Command {
     /// 3-D scan registration: two scans by point-to-plane ICP, or a KITTI/NCLT/Ouster/bag
     /// sequence by KISS-ICP-style odometry, with errors against its reference poses.
     Register(commands::register::Args),
+    /// Print a shell completion script (e.g. `raypath completions bash >
+    /// ~/.local/share/bash-completion/completions/raypath`).
+    Completions(commands::shell::CompletionsArgs),
+    /// Print the man page, or with `--out DIR` write one page per subcommand.
+    Man(commands::shell::ManArgs),
 }
 
 fn main() -> ExitCode {
@@ -107,6 +114,8 @@ fn main() -> ExitCode {
         Command::LoopClosure(args) => commands::loop_closure::run(args),
         Command::Slam(args) => commands::slam::run(args),
         Command::Register(args) => commands::register::run(args),
+        Command::Completions(args) => commands::shell::completions(args, Cli::command()),
+        Command::Man(args) => commands::shell::man(args, Cli::command()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

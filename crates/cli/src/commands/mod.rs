@@ -16,6 +16,7 @@ pub mod register;
 pub mod scan_match;
 pub mod score_model;
 pub mod segcomp_eval;
+pub mod shell;
 pub mod simulate;
 pub mod slam;
 pub mod source_args;
