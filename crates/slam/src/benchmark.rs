@@ -107,6 +107,71 @@ pub fn loop_error(
     Some((t, r.abs()))
 }
 
+/// A relation is **scan-supported** when its reference relative pose lays at least half of
+/// the second scan's points (within [`SUPPORT_RANGE_M`]) within this distance of a point of
+/// the first: 0.1 m (ours).
+pub const SUPPORT_TOLERANCE_M: f64 = 0.1;
+/// Points farther from the sensor than this are left out of the support check, metres.
+pub const SUPPORT_RANGE_M: f64 = 10.0;
+
+/// The relations whose reference the scans themselves support: for `(i, j)`, the points of
+/// scan `j` placed by the reference `x_i⁻¹ x_j` into scan `i`'s frame, and the share of them
+/// with a point of scan `i` within [`SUPPORT_TOLERANCE_M`]; supported when that share is at
+/// least one half (a median nearest-neighbour distance within the tolerance).
+///
+/// A reference derived from a corrected log can be wrong at single scans (the corrected MIT
+/// CSAIL log turns single scans by 10–20° against both neighbours, while the scans align
+/// without the turn); Kümmerle et al. (2009) checked their relations by hand. The check uses
+/// only the reference and the scans, never the estimate, so it cannot favour one. Relations
+/// between scans that do not overlap are not supported either, so the supported set also
+/// leaves out hard relations: report it beside the full set, never instead of it.
+pub fn scan_supported(
+    scans: &[&raypath_geometry::Scan2],
+    reference: &[Option<Pose2>],
+    relations: &[(usize, usize)],
+) -> Vec<(usize, usize)> {
+    let cell = SUPPORT_TOLERANCE_M;
+    let key = |x: f64, y: f64| ((x / cell).floor() as i64, (y / cell).floor() as i64);
+    let near = |p: &nalgebra::Point2<f64>| p.coords.norm() <= SUPPORT_RANGE_M;
+    relations
+        .iter()
+        .copied()
+        .filter(|&(i, j)| {
+            let (Some(Some(xi)), Some(Some(xj)), Some(si), Some(sj)) = (
+                reference.get(i),
+                reference.get(j),
+                scans.get(i),
+                scans.get(j),
+            ) else {
+                return false;
+            };
+            let mut grid: std::collections::HashMap<(i64, i64), Vec<[f64; 2]>> =
+                std::collections::HashMap::new();
+            for p in si.points(Pose2::identity()).filter(near) {
+                grid.entry(key(p.x, p.y)).or_default().push([p.x, p.y]);
+            }
+            let i_from_j = xi.inverse() * *xj;
+            let (mut close, mut total) = (0usize, 0usize);
+            for p in sj.points(Pose2::identity()).filter(near) {
+                let q = i_from_j * p;
+                let (kx, ky) = key(q.x, q.y);
+                total += 1;
+                let hit = (-1..=1).any(|dx| {
+                    (-1..=1).any(|dy| {
+                        grid.get(&(kx + dx, ky + dy)).is_some_and(|cell_points| {
+                            cell_points
+                                .iter()
+                                .any(|c| (c[0] - q.x).hypot(c[1] - q.y) <= SUPPORT_TOLERANCE_M)
+                        })
+                    })
+                });
+                close += usize::from(hit);
+            }
+            total > 0 && 2 * close >= total
+        })
+        .collect()
+}
+
 /// A loop closure is wrong when its association error exceeds this, metres …
 pub const WRONG_LOOP_M: f64 = 0.3;
 /// … or this, degrees.
@@ -304,6 +369,48 @@ mod tests {
         bad[10] = bad[10] * Pose2::new(0.1, 0.0, 0.0);
         let s = relation_errors(&reference, &bad, &rel);
         assert!((s.trans_error_m - 0.2 / 19.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_reference_that_misplaces_a_scan_is_not_supported() {
+        use raypath_geometry::Scan2;
+        // A room's walls seen from two poses 0.3 m apart; the scans are exact.
+        let wall = |x: f64, y: f64, a: f64| {
+            let (c, s) = (a.cos(), a.sin());
+            let t = |o: f64, d: f64, lo: f64, hi: f64| {
+                if d > 1e-12 {
+                    (hi - o) / d
+                } else if d < -1e-12 {
+                    (lo - o) / d
+                } else {
+                    f64::INFINITY
+                }
+            };
+            t(x, c, -3.0, 4.0).min(t(y, s, -2.0, 2.5))
+        };
+        let poses = [Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.3, 0.1, 0.05)];
+        let scans: Vec<Scan2> = poses
+            .iter()
+            .map(|p| Scan2 {
+                angle_min_rad: -std::f64::consts::PI,
+                angle_increment_rad: std::f64::consts::PI / 180.0,
+                max_range_m: 30.0,
+                ranges: (0..360)
+                    .map(|k| {
+                        let a = -std::f64::consts::PI + k as f64 * std::f64::consts::PI / 180.0;
+                        wall(p.x(), p.y(), p.theta() + a)
+                    })
+                    .collect(),
+                intensities: None,
+            })
+            .collect();
+        let refs: Vec<&Scan2> = scans.iter().collect();
+        let right = vec![Some(poses[0]), Some(poses[1])];
+        assert_eq!(scan_supported(&refs, &right, &[(0, 1)]), vec![(0, 1)]);
+        let turned = vec![Some(poses[0]), Some(poses[1] * Pose2::new(0.0, 0.0, 0.2))];
+        assert!(scan_supported(&refs, &turned, &[(0, 1)]).is_empty());
+        let missing = vec![Some(poses[0]), None];
+        assert!(scan_supported(&refs, &missing, &[(0, 1)]).is_empty());
     }
 
     #[test]
