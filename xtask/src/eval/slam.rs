@@ -527,3 +527,77 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         headline: None,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn summary(trans: f64, relations: usize) -> ErrorSummary {
+        ErrorSummary {
+            trans_error_m: trans,
+            trans_error_std_m: trans / 2.0,
+            rot_error_deg: 0.5,
+            rot_error_std_deg: 0.25,
+            relations,
+        }
+    }
+
+    fn table() -> Table {
+        Table::new([
+            "log",
+            "method",
+            "relations",
+            "t",
+            "r",
+            "supported",
+            "random",
+            "loops",
+            "wrong",
+            "seconds",
+            "scans/s",
+        ])
+    }
+
+    /// One row: the cells and the JSON the published table reads back.
+    #[test]
+    fn row_and_published_table_from_known_scores() {
+        let s = Scored {
+            consecutive: summary(0.03, 100),
+            supported: summary(0.02, 97),
+            random: summary(0.2, 1000),
+            loops: 12,
+            rejected: 3,
+            wrong: 1,
+            checked: 11,
+            seconds: 2.0,
+            scans: 500,
+        };
+        let mut t = table();
+        let json = row(&mut t, "intel", "raypath-slam", &s);
+        let md = t.to_markdown().unwrap();
+        let cells: Vec<&str> = md
+            .lines()
+            .last()
+            .unwrap()
+            .split('|')
+            .map(str::trim)
+            .collect();
+        assert_eq!(cells[3], "100");
+        assert_eq!(cells[4], "0.0300 ± 0.0150");
+        assert_eq!(cells[6], "0.0200 ± 0.0100 (97 of 100)");
+        assert_eq!(cells[8], "12 / 3");
+        assert_eq!(cells[9], "1 of 11");
+        assert_eq!(cells[11], "250");
+        let mut page = String::new();
+        published(&mut page, &[json]).unwrap();
+        let intel = page.lines().find(|l| l.starts_with("| intel")).unwrap();
+        assert!(intel.contains("0.0300 ± 0.0150") && intel.contains("0.0200 ± 0.0100"));
+        assert!(
+            intel.contains("0.0229 ± 0.0239"),
+            "Cartographer's figure: {intel}"
+        );
+        let fr079 = page.lines().find(|l| l.starts_with("| fr079")).unwrap();
+        assert!(fr079.contains("not run"), "{fr079}");
+        assert!(page.lines().filter(|l| l.contains("| no:")).count() == 3);
+    }
+}

@@ -424,3 +424,77 @@ fn headline(real: &serde_json::Value, f2: f64, t2: f64, peac_t2: f64) -> Option<
         )
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scan(f: f64, rmse_mm: f64, secs: f64) -> Scan {
+        Scan {
+            f,
+            k: 90.0,
+            rmse_mm,
+            gt: 10.0,
+            planes: 12.0,
+            secs,
+            ..Scan::default()
+        }
+    }
+
+    /// Means over the scans, the RMSE ≤ 20 mm average with its count, the median time.
+    #[test]
+    fn row_writes_means_the_reference_rmse_and_the_median_time() {
+        let scans = [
+            scan(60.0, 10.0, 1.0),
+            scan(80.0, 30.0, 3.0),
+            scan(70.0, 20.0, 2.0),
+        ];
+        let mut t = Table::new([
+            "set",
+            "scans",
+            "gt",
+            "planes",
+            "f",
+            "k",
+            "rmse",
+            "rmse ≤ 20",
+            "n_o",
+            "n_u",
+            "n_m",
+            "n_s",
+            "time",
+        ]);
+        row(&mut t, "test", &scans);
+        let md = t.to_markdown().unwrap();
+        let line = md.lines().last().unwrap();
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        assert_eq!(
+            &cells[1..8],
+            ["test", "3", "10.0", "12.0", "70.0", "90.0", "20.0"]
+        );
+        assert_eq!(cells[8], "15.0 (2)");
+        assert_eq!(cells[13], "2.00");
+        let j = json(&scans);
+        assert_eq!(j["rmse_ref_scans"], 2);
+        assert_eq!(j["median_seconds"], 2.0);
+    }
+
+    /// The headline leads with the real KITTI figures and says the σ = 2 cm row is simulated.
+    #[test]
+    fn headline_leads_with_real_data_and_marks_the_simulated_part() {
+        let real = serde_json::json!({"kitti": {
+            "ppe_kitti_held_out": {"f1": 0.84, "median_seconds": 0.5},
+            "peac_kitti_held_out": {"f1": 0.815},
+            "msac_kitti_held_out": {"f1": 0.812},
+        }});
+        let h = headline(&real, 74.1, 1.9, 0.09).unwrap();
+        assert!(h.starts_with("Real KITTI 01, 04, 07"), "{h}");
+        assert!(h.contains("PPE F1 84.0 % at 0.50 s"), "{h}");
+        assert!(
+            h.contains("(simulated, σ = 2 cm): PPE f 74.1 % at 1.90 s"),
+            "{h}"
+        );
+        assert!(h.contains("not like for like"), "{h}");
+        assert!(headline(&serde_json::json!({}), f64::NAN, 0.0, 0.0).is_none());
+    }
+}
