@@ -145,3 +145,44 @@ pub fn headline(real_rows: &[Value], simulated: Option<&(String, f64)>) -> Optio
         span(&values(&["equal_value", "bytes_ratio"], 1.0), 2),
     ))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn span_gives_a_range_or_one_value() {
+        assert_eq!(span(&[1.234, 5.0, 2.0], 1), "1.2 to 5.0");
+        assert_eq!(span(&[0.801, 0.799], 2), "0.80");
+        assert_eq!(span(&[], 2), "—");
+    }
+
+    /// Ranges over the real rows, the simulated set after them, and the comparability note.
+    #[test]
+    fn headline_over_known_real_rows() {
+        let rows = [
+            json!({"data": "scan.dat", "leaf_reduction": -0.5, "insertion_time_ratio": 0.2,
+                   "equal_value": {"leaf_reduction": 0.6, "insertion_time_ratio": 0.8, "bytes_ratio": 0.4}}),
+            json!({"data": "kitti-00", "leaf_reduction": 0.1, "insertion_time_ratio": 2.0,
+                   "equal_value": {"leaf_reduction": 0.2, "insertion_time_ratio": 3.0, "bytes_ratio": 0.9}}),
+        ];
+        let h = headline(&rows, Some(&("urban".to_owned(), 0.064))).unwrap();
+        assert!(h.starts_with("Real scans (scan.dat, kitti-00;"), "{h}");
+        assert!(h.contains("gives -50.0 to 10.0 % fewer leaves"), "{h}");
+        assert!(h.contains("at 0.20 to 2.00× its insertion time"), "{h}");
+        assert!(
+            h.contains("equal-value fusion 20.0 to 60.0 % fewer leaves"),
+            "{h}"
+        );
+        assert!(h.contains("0.40 to 0.90× the bytes"), "{h}");
+        assert!(
+            h.contains("simulated `urban`: thesis rule 6.4 % fewer leaves"),
+            "{h}"
+        );
+        assert!(
+            h.ends_with("(its Freiburg campus graph is not available)."),
+            "{h}"
+        );
+        assert!(headline(&[], None).is_none());
+    }
+}
