@@ -209,7 +209,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         if !left_out.is_empty() {
             notes.push(format!(
                 "Semi-synthetic sequences not run this time: {} (`POLES_KITTI_SEQUENCES` selected \
-                 {}; Table 12.2 has all eight, and a run of all eight takes about 100 min here).",
+                 {}; Table 12.2 has all eight: run without the variable for them).",
                 left_out.join(", "),
                 covered.join(", ")
             ));
