@@ -373,32 +373,32 @@ mod tests {
 
     #[test]
     fn a_reference_that_misplaces_a_scan_is_not_supported() {
+        use nalgebra::Point2;
         use raypath_geometry::Scan2;
-        // A room's walls seen from two poses 0.3 m apart; the scans are exact.
-        let wall = |x: f64, y: f64, a: f64| {
-            let (c, s) = (a.cos(), a.sin());
-            let t = |o: f64, d: f64, lo: f64, hi: f64| {
-                if d > 1e-12 {
-                    (hi - o) / d
-                } else if d < -1e-12 {
-                    (lo - o) / d
-                } else {
-                    f64::INFINITY
-                }
-            };
-            t(x, c, -3.0, 4.0).min(t(y, s, -2.0, 2.5))
-        };
+        use raypath_sim::scene2::{SceneBuilder2, Surface};
+        // A 7 m × 4.5 m room seen from two poses 0.3 m apart; the scans are exact.
+        let mut room = SceneBuilder2::new();
+        let wall = room.add_surface(Surface {
+            label: 10,
+            reflectivity: 0.5,
+        });
+        let corners = [(-3.0, -2.0), (4.0, -2.0), (4.0, 2.5), (-3.0, 2.5)];
+        room.add_polygon(&corners.map(|(x, y)| Point2::new(x, y)), wall);
+        let room = room.build().unwrap();
+        let step = std::f64::consts::PI / 180.0;
         let poses = [Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.3, 0.1, 0.05)];
         let scans: Vec<Scan2> = poses
             .iter()
             .map(|p| Scan2 {
                 angle_min_rad: -std::f64::consts::PI,
-                angle_increment_rad: std::f64::consts::PI / 180.0,
+                angle_increment_rad: step,
                 max_range_m: 30.0,
                 ranges: (0..360)
                     .map(|k| {
-                        let a = -std::f64::consts::PI + k as f64 * std::f64::consts::PI / 180.0;
-                        wall(p.x(), p.y(), p.theta() + a)
+                        let a = p.theta() - std::f64::consts::PI + k as f64 * step;
+                        let origin = Point2::new(p.x(), p.y());
+                        room.cast_angle(&origin, a, 30.0)
+                            .map_or(30.0, |h| h.range_m)
                     })
                     .collect(),
                 intensities: None,
