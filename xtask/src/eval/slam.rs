@@ -110,28 +110,42 @@ fn run_slam(frames: &[PlanarFrame], config: SlamConfig) -> Result<(SlamOutput, f
     Ok((out, started.elapsed().as_secs_f64()))
 }
 
-fn score(
-    frames: &[PlanarFrame],
-    poses: &[Pose2],
-    out: Option<&SlamOutput>,
-    seconds: f64,
-) -> Scored {
-    let truth: Vec<Option<Pose2>> = frames.iter().map(|f| f.reference).collect();
-    let referenced: Vec<usize> = (0..frames.len()).filter(|&i| truth[i].is_some()).collect();
-    let relations = consecutive_relations(&referenced);
-    let consecutive = relation_errors(&truth, poses, &relations);
-    let scans: Vec<&raypath_geometry::Scan2> = frames.iter().map(|f| &f.scan).collect();
-    let supported = relation_errors(&truth, poses, &scan_supported(&scans, &truth, &relations));
-    let random = relation_errors(
-        &truth,
-        poses,
-        &random_relations(&referenced, RANDOM_PAIRS, SEED),
-    );
+/// A log's reference and relation sets: they depend on the frames only, so every method run
+/// on the log is scored against the same sets, computed once.
+struct Relations {
+    truth: Vec<Option<Pose2>>,
+    consecutive: Vec<(usize, usize)>,
+    supported: Vec<(usize, usize)>,
+    random: Vec<(usize, usize)>,
+}
+
+impl Relations {
+    fn of(frames: &[PlanarFrame]) -> Self {
+        let truth: Vec<Option<Pose2>> = frames.iter().map(|f| f.reference).collect();
+        let referenced: Vec<usize> = (0..frames.len()).filter(|&i| truth[i].is_some()).collect();
+        let consecutive = consecutive_relations(&referenced);
+        let scans: Vec<&raypath_geometry::Scan2> = frames.iter().map(|f| &f.scan).collect();
+        let supported = scan_supported(&scans, &truth, &consecutive);
+        let random = random_relations(&referenced, RANDOM_PAIRS, SEED);
+        Self {
+            truth,
+            consecutive,
+            supported,
+            random,
+        }
+    }
+}
+
+fn score(rel: &Relations, poses: &[Pose2], out: Option<&SlamOutput>, seconds: f64) -> Scored {
+    let truth = &rel.truth;
+    let consecutive = relation_errors(truth, poses, &rel.consecutive);
+    let supported = relation_errors(truth, poses, &rel.supported);
+    let random = relation_errors(truth, poses, &rel.random);
     let (mut wrong, mut checked, mut loops, mut rejected) = (0, 0, 0, 0);
     if let Some(out) = out {
         loops = out.loop_closures.len();
         rejected = out.rejected_loop_closures.len();
-        (checked, wrong, _) = check_loops(out, &truth, 50);
+        (checked, wrong, _) = check_loops(out, truth, 50);
     }
     Scored {
         consecutive,
@@ -142,7 +156,7 @@ fn score(
         wrong,
         checked,
         seconds,
-        scans: frames.len(),
+        scans: poses.len(),
     }
 }
 
@@ -235,12 +249,13 @@ fn referenced(ctx: &EvalContext, md: &mut String) -> Result<Vec<Value>> {
         let mut frames = read(ctx, raw, limit)?;
         let reference = read(ctx, corrected, None)?;
         pair_reference(&mut frames, &reference);
+        let relations = Relations::of(&frames);
         let odometry: Vec<Pose2> = frames.iter().map(|f| f.world_from_laser).collect();
         rows.push(row(
             &mut table,
             name,
             "odometry",
-            &score(&frames, &odometry, None, 0.0),
+            &score(&relations, &odometry, None, 0.0),
         ));
         let started = Instant::now();
         let matcher = raypath_reflectivity::MatcherConfig {
@@ -252,7 +267,7 @@ fn referenced(ctx: &EvalContext, md: &mut String) -> Result<Vec<Value>> {
         };
         let (_, results) = run_matcher(&frames, matcher, &PointFilter::default(), None, true)?;
         let hector: Vec<Pose2> = results.iter().map(|r| r.world_from_sensor).collect();
-        let s = score(&frames, &hector, None, started.elapsed().as_secs_f64());
+        let s = score(&relations, &hector, None, started.elapsed().as_secs_f64());
         rows.push(row(
             &mut table,
             name,
@@ -261,7 +276,7 @@ fn referenced(ctx: &EvalContext, md: &mut String) -> Result<Vec<Value>> {
         ));
         for (label, config) in variants(ctx.quick) {
             let (out, seconds) = run_slam(&frames, config)?;
-            let s = score(&frames, &out.world_from_sensor, Some(&out), seconds);
+            let s = score(&relations, &out.world_from_sensor, Some(&out), seconds);
             rows.push(row(&mut table, name, label, &s));
         }
         bar.inc(1);
@@ -415,6 +430,7 @@ fn residual_ablation(ctx: &EvalContext, md: &mut String) -> Result<Vec<Value>> {
             frames.truncate(600);
         }
         pair_reference(&mut frames, &read_planar(&corrected, &options)?);
+        let relations = Relations::of(&frames);
         let modes: &[ResidualMode] = if frames.iter().any(|f| f.scan.intensities.is_some()) {
             &[ResidualMode::Occupancy, ResidualMode::Combined]
         } else {
@@ -434,7 +450,7 @@ fn residual_ablation(ctx: &EvalContext, md: &mut String) -> Result<Vec<Value>> {
             }
             let out = slam.finish()?;
             let s = score(
-                &frames,
+                &relations,
                 &out.world_from_sensor,
                 Some(&out),
                 started.elapsed().as_secs_f64(),
