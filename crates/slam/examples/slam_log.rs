@@ -127,21 +127,39 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
             }
         }
-        let (checked, wrong, errors) = raypath_slam::benchmark::check_loops(&out, &reference, 50);
+        let (checked, wrong, checks) = raypath_slam::benchmark::check_loops(&out, &reference, 50);
         println!("loop closures: {wrong} of {checked} checked wrong");
+        for cut in [0.3, 0.5, 0.7] {
+            let low = |wrong: bool| {
+                checks
+                    .iter()
+                    .filter(|k| k.is_wrong() == wrong)
+                    .filter(|k| out.graph.edge_weight(out.loop_closures[k.closure].edge) < cut)
+                    .count()
+            };
+            println!("weight < {cut}: {} right, {} wrong", low(false), low(true));
+        }
         if std::env::var("SLAM_LOOPS").is_ok() {
-            for (c, (t, r)) in out.loop_closures.iter().zip(&errors) {
-                if *t > 0.15 || r.to_degrees() > 1.5 {
-                    let (a, b) = (out.node_scan[c.anchor], out.node_scan[c.node]);
-                    println!(
-                        "loop {a}->{b} {:?} score {:.3} error {t:.3} m {:.2}° weight {:.3} chi2 {:.1}",
-                        c.source,
-                        c.score,
-                        r.to_degrees(),
-                        out.graph.edge_weight(c.edge),
-                        out.graph.edge_chi2(c.edge)
-                    );
-                }
+            let scans: Vec<_> = frames.iter().map(|f| &f.scan).collect();
+            for k in checks.iter().filter(|k| k.is_wrong()) {
+                let c = &out.loop_closures[k.closure];
+                let (a, b) = (scans[k.near_scan], scans[k.scan]);
+                let share = |p| raypath_slam::benchmark::support_share(a, b, p).unwrap_or(0.0);
+                println!(
+                    "loop {}->{} {:?} score {:.3} error {:.3} m {:.2}° weight {:.3} chi2 {:.1} \
+                     support measured {:.2} reference {:.2}, reference disputed: {}",
+                    k.near_scan,
+                    k.scan,
+                    c.source,
+                    c.score,
+                    k.trans_m,
+                    k.rot_rad.to_degrees(),
+                    out.graph.edge_weight(c.edge),
+                    out.graph.edge_chi2(c.edge),
+                    share(&k.measured),
+                    share(&k.reference()),
+                    k.reference_disputed(&scans, &reference),
+                );
             }
         }
         let refs: Vec<_> = referenced.iter().filter_map(|&i| reference[i]).collect();

@@ -130,9 +130,6 @@ pub fn scan_supported(
     reference: &[Option<Pose2>],
     relations: &[(usize, usize)],
 ) -> Vec<(usize, usize)> {
-    let cell = SUPPORT_TOLERANCE_M;
-    let key = |x: f64, y: f64| ((x / cell).floor() as i64, (y / cell).floor() as i64);
-    let near = |p: &nalgebra::Point2<f64>| p.coords.norm() <= SUPPORT_RANGE_M;
     relations
         .iter()
         .copied()
@@ -145,31 +142,84 @@ pub fn scan_supported(
             ) else {
                 return false;
             };
-            let mut grid: std::collections::HashMap<(i64, i64), Vec<[f64; 2]>> =
-                std::collections::HashMap::new();
-            for p in si.points(Pose2::identity()).filter(near) {
-                grid.entry(key(p.x, p.y)).or_default().push([p.x, p.y]);
-            }
-            let i_from_j = xi.inverse() * *xj;
-            let (mut close, mut total) = (0usize, 0usize);
-            for p in sj.points(Pose2::identity()).filter(near) {
-                let q = i_from_j * p;
-                let (kx, ky) = key(q.x, q.y);
-                total += 1;
-                let hit = (-1..=1).any(|dx| {
-                    (-1..=1).any(|dy| {
-                        grid.get(&(kx + dx, ky + dy)).is_some_and(|cell_points| {
-                            cell_points
-                                .iter()
-                                .any(|c| (c[0] - q.x).hypot(c[1] - q.y) <= SUPPORT_TOLERANCE_M)
-                        })
-                    })
-                });
-                close += usize::from(hit);
-            }
-            total > 0 && 2 * close >= total
+            support_share(si, sj, &(xi.inverse() * *xj)).is_some_and(|s| s >= 0.5)
         })
         .collect()
+}
+
+/// The share of scan `j`'s points (within [`SUPPORT_RANGE_M`] of its sensor) that the
+/// relative pose `i_from_j` lays within [`SUPPORT_TOLERANCE_M`] of a point of scan `i`;
+/// `None` when scan `j` has no such point.
+pub fn support_share(
+    scan_i: &raypath_geometry::Scan2,
+    scan_j: &raypath_geometry::Scan2,
+    i_from_j: &Pose2,
+) -> Option<f64> {
+    let index = PointIndex::new(near_points(scan_i, &Pose2::identity()));
+    index.share(near_points(scan_j, i_from_j))
+}
+
+/// The points of `scan` within [`SUPPORT_RANGE_M`] of its sensor, placed by `pose`.
+pub fn near_points<'a>(
+    scan: &'a raypath_geometry::Scan2,
+    pose: &'a Pose2,
+) -> impl Iterator<Item = nalgebra::Point2<f64>> + 'a {
+    scan.points(Pose2::identity())
+        .filter(|p| p.coords.norm() <= SUPPORT_RANGE_M)
+        .map(move |p| *pose * p)
+}
+
+/// Points hashed into [`SUPPORT_TOLERANCE_M`] cells, for "is there a point within the
+/// tolerance" queries.
+#[derive(Debug, Default)]
+pub struct PointIndex {
+    cells: std::collections::HashMap<(i64, i64), Vec<[f64; 2]>>,
+}
+
+impl PointIndex {
+    /// Indexes `points`.
+    pub fn new(points: impl IntoIterator<Item = nalgebra::Point2<f64>>) -> Self {
+        let mut index = Self::default();
+        for p in points {
+            index
+                .cells
+                .entry(Self::key(&p))
+                .or_default()
+                .push([p.x, p.y]);
+        }
+        index
+    }
+
+    fn key(p: &nalgebra::Point2<f64>) -> (i64, i64) {
+        let cell = SUPPORT_TOLERANCE_M;
+        ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64)
+    }
+
+    /// Whether an indexed point lies within [`SUPPORT_TOLERANCE_M`] of `q`.
+    pub fn near(&self, q: &nalgebra::Point2<f64>) -> bool {
+        let (kx, ky) = Self::key(q);
+        (-1..=1).any(|dx| {
+            (-1..=1).any(|dy| {
+                self.cells
+                    .get(&(kx + dx, ky + dy))
+                    .is_some_and(|cell_points| {
+                        cell_points
+                            .iter()
+                            .any(|c| (c[0] - q.x).hypot(c[1] - q.y) <= SUPPORT_TOLERANCE_M)
+                    })
+            })
+        })
+    }
+
+    /// The share of `points` near an indexed point; `None` for no points.
+    pub fn share(&self, points: impl IntoIterator<Item = nalgebra::Point2<f64>>) -> Option<f64> {
+        let (mut close, mut total) = (0usize, 0usize);
+        for q in points {
+            total += 1;
+            close += usize::from(self.near(&q));
+        }
+        (total > 0).then(|| close as f64 / total as f64)
+    }
 }
 
 /// A loop closure is wrong when its association error exceeds this, metres …
@@ -185,17 +235,17 @@ pub const WRONG_LOOP_DEG: f64 = 3.0;
 /// anchor-to-node relation would also charge the loop for the submap's own bending over its
 /// length, which the intra-submap constraints carry. Scans without a reference borrow one
 /// from the nearest referenced scan within `max_gap` scans ([`reference_by_neighbour`]).
-/// Returns `(checked, wrong, errors)` with one `(m, rad)` per checked loop closure.
+/// Returns `(checked, wrong, checks)` with one [`LoopCheck`] per checked loop closure.
 pub fn check_loops(
     output: &crate::SlamOutput,
     reference: &[Option<Pose2>],
     max_gap: usize,
-) -> (usize, usize, Vec<(f64, f64)>) {
+) -> (usize, usize, Vec<LoopCheck>) {
     let local: Vec<Pose2> = output.scans.iter().map(|s| s.local).collect();
     let near = reference_by_neighbour(reference, &local, max_gap);
     let node_local = |n: usize| output.node_scan.get(n).and_then(|&k| local.get(k)).copied();
-    let mut errors = Vec::new();
-    for c in &output.loop_closures {
+    let mut checks = Vec::new();
+    for (closure, c) in output.loop_closures.iter().enumerate() {
         let (Some(submap), Some(anchor_local), Some(&scan)) = (
             output.submaps.get(c.submap),
             node_local(c.anchor),
@@ -219,19 +269,108 @@ pub fn check_loops(
             continue;
         };
         let measured = submap_from_k.inverse() * c.submap_from_sensor;
-        if let Some(e) = loop_error(
+        let (reference_near, reference_scan) = (
             near.get(k_scan).copied().flatten(),
             near.get(scan).copied().flatten(),
-            measured,
+        );
+        if let (Some((trans_m, rot_rad)), Some(a), Some(b)) = (
+            loop_error(reference_near, reference_scan, measured),
+            reference_near,
+            reference_scan,
         ) {
-            errors.push(e);
+            checks.push(LoopCheck {
+                closure,
+                near_scan: k_scan,
+                scan,
+                measured,
+                reference_near: a,
+                reference_scan: b,
+                trans_m,
+                rot_rad,
+            });
         }
     }
-    let wrong = errors
-        .iter()
-        .filter(|(t, r)| *t > WRONG_LOOP_M || r.to_degrees() > WRONG_LOOP_DEG)
-        .count();
-    (errors.len(), wrong, errors)
+    let wrong = checks.iter().filter(|c| c.is_wrong()).count();
+    (checks.len(), wrong, checks)
+}
+
+/// One loop closure checked against the reference by [`check_loops`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LoopCheck {
+    /// Index into [`crate::SlamOutput::loop_closures`].
+    pub closure: usize,
+    /// The scan of the submap node nearest to where the loop closure placed its scan.
+    pub near_scan: usize,
+    /// The scan the loop closure placed.
+    pub scan: usize,
+    /// The loop closure's relative pose `near_scan ← scan`.
+    pub measured: Pose2,
+    /// The reference pose of `near_scan` (borrowed by neighbour where the scan has no
+    /// reference of its own).
+    pub reference_near: Pose2,
+    /// The reference pose of `scan` (borrowed likewise).
+    pub reference_scan: Pose2,
+    /// Association error: translation, metres.
+    pub trans_m: f64,
+    /// Association error: absolute angle, radians.
+    pub rot_rad: f64,
+}
+
+impl LoopCheck {
+    /// Above [`WRONG_LOOP_M`] or [`WRONG_LOOP_DEG`].
+    pub fn is_wrong(&self) -> bool {
+        self.trans_m > WRONG_LOOP_M || self.rot_rad.to_degrees() > WRONG_LOOP_DEG
+    }
+
+    /// The reference's relative pose `near_scan ← scan`.
+    pub fn reference(&self) -> Pose2 {
+        self.reference_near.inverse() * self.reference_scan
+    }
+
+    /// Whether the reference itself is in doubt at this loop closure: one of its two scans,
+    /// placed at its reference pose, has less than half of its points (within
+    /// [`SUPPORT_RANGE_M`]) within [`SUPPORT_TOLERANCE_M`] of the points of the referenced
+    /// scans more than [`DISPUTE_GAP`] scans away, placed at theirs ([`reference_support`]).
+    /// A corrected log can be wrong at single scans; an association error measured against
+    /// such a reference says nothing about the loop closure. Reported beside the wrong
+    /// count, never instead of it.
+    pub fn reference_disputed(
+        &self,
+        scans: &[&raypath_geometry::Scan2],
+        reference: &[Option<Pose2>],
+    ) -> bool {
+        [
+            (self.near_scan, self.reference_near),
+            (self.scan, self.reference_scan),
+        ]
+        .into_iter()
+        .any(|(i, pose)| reference_support(scans, reference, i, &pose).is_some_and(|s| s < 0.5))
+    }
+}
+
+/// Scans closer than this (by index) to the scan under test are left out of the map that
+/// [`reference_support`] checks it against: 30, a few metres of travel in the logs we read.
+pub const DISPUTE_GAP: usize = 30;
+
+/// The share of scan `i`'s points (within [`SUPPORT_RANGE_M`]), placed at `pose`, within
+/// [`SUPPORT_TOLERANCE_M`] of the points of every referenced scan more than [`DISPUTE_GAP`]
+/// scans from `i`, placed at its reference pose; `None` without points.
+pub fn reference_support(
+    scans: &[&raypath_geometry::Scan2],
+    reference: &[Option<Pose2>],
+    i: usize,
+    pose: &Pose2,
+) -> Option<f64> {
+    let map = PointIndex::new(
+        scans
+            .iter()
+            .zip(reference)
+            .enumerate()
+            .filter(|(m, _)| m.abs_diff(i) > DISPUTE_GAP)
+            .filter_map(|(_, (scan, r))| Some(near_points(scan, r.as_ref()?).collect::<Vec<_>>()))
+            .flatten(),
+    );
+    map.share(near_points(scans.get(i)?, pose))
 }
 
 /// Self-consistency of a map without reference poses: of the confidently occupied cells of
@@ -371,12 +510,11 @@ mod tests {
         assert!((s.trans_error_m - 0.2 / 19.0).abs() < 1e-9);
     }
 
-    #[test]
-    fn a_reference_that_misplaces_a_scan_is_not_supported() {
+    /// Exact 360-beam scans of a 7 m × 4.5 m room from `poses`.
+    fn room_scans(poses: &[Pose2]) -> Vec<raypath_geometry::Scan2> {
         use nalgebra::Point2;
         use raypath_geometry::Scan2;
         use raypath_sim::scene2::{SceneBuilder2, Surface};
-        // A 7 m × 4.5 m room seen from two poses 0.3 m apart; the scans are exact.
         let mut room = SceneBuilder2::new();
         let wall = room.add_surface(Surface {
             label: 10,
@@ -386,8 +524,7 @@ mod tests {
         room.add_polygon(&corners.map(|(x, y)| Point2::new(x, y)), wall);
         let room = room.build().unwrap();
         let step = std::f64::consts::PI / 180.0;
-        let poses = [Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.3, 0.1, 0.05)];
-        let scans: Vec<Scan2> = poses
+        poses
             .iter()
             .map(|p| Scan2 {
                 angle_min_rad: -std::f64::consts::PI,
@@ -403,7 +540,15 @@ mod tests {
                     .collect(),
                 intensities: None,
             })
-            .collect();
+            .collect()
+    }
+
+    #[test]
+    fn a_reference_that_misplaces_a_scan_is_not_supported() {
+        use raypath_geometry::Scan2;
+        // Two poses 0.3 m apart; the scans are exact.
+        let poses = [Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.3, 0.1, 0.05)];
+        let scans = room_scans(&poses);
         let refs: Vec<&Scan2> = scans.iter().collect();
         let right = vec![Some(poses[0]), Some(poses[1])];
         assert_eq!(scan_supported(&refs, &right, &[(0, 1)]), vec![(0, 1)]);
@@ -411,6 +556,41 @@ mod tests {
         assert!(scan_supported(&refs, &turned, &[(0, 1)]).is_empty());
         let missing = vec![Some(poses[0]), None];
         assert!(scan_supported(&refs, &missing, &[(0, 1)]).is_empty());
+    }
+
+    #[test]
+    fn a_reference_pose_that_disagrees_with_the_rest_is_disputed() {
+        use raypath_geometry::Scan2;
+        // 80 scans along the room; the reference turns scan 40 by 0.2 rad.
+        let poses: Vec<Pose2> = (0..80)
+            .map(|k| Pose2::new(-2.0 + 0.06 * k as f64, 0.2, 0.01 * k as f64))
+            .collect();
+        let scans = room_scans(&poses);
+        let refs: Vec<&Scan2> = scans.iter().collect();
+        let mut reference: Vec<Option<Pose2>> = poses.iter().copied().map(Some).collect();
+        let right = reference_support(&refs, &reference, 40, &poses[40]).unwrap();
+        assert!(right > 0.95, "{right}");
+        let turned = poses[40] * Pose2::new(0.0, 0.0, 0.2);
+        reference[40] = Some(turned);
+        let wrong = reference_support(&refs, &reference, 40, &turned).unwrap();
+        assert!(wrong < 0.5, "{wrong}");
+        let check = LoopCheck {
+            closure: 0,
+            near_scan: 0,
+            scan: 40,
+            measured: poses[0].inverse() * poses[40],
+            reference_near: poses[0],
+            reference_scan: turned,
+            trans_m: 0.0,
+            rot_rad: 0.2,
+        };
+        assert!(check.is_wrong() && check.reference_disputed(&refs, &reference));
+        let undisputed = LoopCheck {
+            reference_scan: poses[40],
+            ..check
+        };
+        reference[40] = Some(poses[40]);
+        assert!(!undisputed.reference_disputed(&refs, &reference));
     }
 
     #[test]

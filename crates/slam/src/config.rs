@@ -161,8 +161,11 @@ pub struct SlamConfig {
     /// Optimise the pose graph after this many new nodes when new loop constraints have come
     /// in; once more at the end. Default 50.
     pub optimize_every_nodes: usize,
-    /// After an optimisation, loop edges whose robust weight fell below this are removed as
-    /// wrong (and counted as rejected). Default 0.1.
+    /// Loop edges whose robust weight ([`PoseGraph::edge_weight`](crate::PoseGraph::edge_weight))
+    /// ends below this at the final optimisation are rejected: switched off, and the graph
+    /// optimised once more without them. Default 0.5 (ours): on the Intel, Freiburg 079
+    /// and MIT CSAIL raw logs every loop closure that the map of the corrected log refutes
+    /// ended with a weight of 0.21–0.44, and 2 of about 1 400 right ones below 0.5.
     pub reject_weight: f64,
 }
 
@@ -179,7 +182,7 @@ impl Default for SlamConfig {
             loop_sigma: [0.05, 0.05, 1f64.to_radians()],
             solver: SolverConfig::default(),
             optimize_every_nodes: 50,
-            reject_weight: 0.1,
+            reject_weight: 0.5,
         }
     }
 }

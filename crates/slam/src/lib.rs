@@ -35,7 +35,7 @@
 //! the anchor of a finished submap. The pose graph is optimised every
 //! [`SlamConfig::optimize_every_nodes`] nodes when new loop closures came in, and once more at
 //! the end; loop edges whose robust weight ends below [`SlamConfig::reject_weight`] are
-//! reported as rejected.
+//! rejected: switched off, and the graph optimised once more without them.
 //!
 //! ## Decisions (none of this is in the theses)
 //!

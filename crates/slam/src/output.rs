@@ -58,7 +58,8 @@ pub struct SlamOutput {
     /// Accepted loop closures (robust weight at the final optimisation at least
     /// [`crate::SlamConfig::reject_weight`]).
     pub loop_closures: Vec<LoopClosure>,
-    /// Loop closures the robust pose graph switched off.
+    /// Loop closures whose robust weight ended below [`crate::SlamConfig::reject_weight`];
+    /// they were switched off before the last optimisation.
     pub rejected_loop_closures: Vec<LoopClosure>,
     /// The final pose graph.
     pub graph: PoseGraph,

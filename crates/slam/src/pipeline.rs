@@ -274,14 +274,16 @@ impl Slam {
             self.optimise()?;
         }
         let loop_stats = self.loops.as_ref().map(|l| l.stats).unwrap_or_default();
-        let mut accepted = Vec::new();
-        let mut rejected = Vec::new();
-        for c in self.closures {
-            if self.graph.edge_weight(c.edge) >= self.config.reject_weight {
-                accepted.push(c);
-            } else {
-                rejected.push(c);
+        let (accepted, rejected): (Vec<_>, Vec<_>) = std::mem::take(&mut self.closures)
+            .into_iter()
+            .partition(|c| self.graph.edge_weight(c.edge) >= self.config.reject_weight);
+        if !rejected.is_empty() {
+            // Rejected loop closures leave the graph before a last optimisation, so no
+            // discounted wrong edge pulls on the result.
+            for c in &rejected {
+                self.graph.switch_off(c.edge);
             }
+            self.optimise()?;
         }
         let nodes = self.graph.nodes().to_vec();
         let world_from_sensor = self

@@ -23,7 +23,8 @@
 //! 2009; scans paired with the corrected log by identical readings), `"random_pairs"` (the
 //! same over 1000 seeded random pairs) and `"wrong_loop_closures"` (accepted loop closures
 //! whose association error is above 0.3 m or 3°, `raypath_slam::benchmark::check_loops`, of
-//! `"loop_closures_checked"`).
+//! `"loop_closures_checked"`; `"wrong_loop_closures_reference_disputed"` counts those of
+//! them where the corrected log disagrees with its own scans, `LoopCheck::reference_disputed`).
 //!
 //! `--record OUT.mcap`: every scan at its optimised pose (`/tf`, `/scan`), the `/trajectory`,
 //! the rebuilt map as `/map` and the loop closures as lines (`/loops`).
@@ -302,13 +303,19 @@ fn evaluate(
         &out.world_from_sensor,
         &random_relations(&referenced, 1000, 1),
     );
-    let (checked, wrong, _) = check_loops(out, &truth, NEIGHBOUR_GAP);
+    let (checked, wrong, checks) = check_loops(out, &truth, NEIGHBOUR_GAP);
+    let scans: Vec<_> = frames.iter().map(|f| &f.scan).collect();
+    let disputed = checks
+        .iter()
+        .filter(|c| c.is_wrong() && c.reference_disputed(&scans, &truth))
+        .count();
     Ok(json!({
         "paired_scans": paired,
         "summary": summary,
         "random_pairs": random,
         "loop_closures_checked": checked,
         "wrong_loop_closures": wrong,
+        "wrong_loop_closures_reference_disputed": disputed,
     }))
 }
 

@@ -169,6 +169,16 @@ impl PoseGraph {
         Ok(index)
     }
 
+    /// Switches edge `e` off: its information becomes zero, so it no longer acts on the
+    /// poses, while the graph keeps its sparsity pattern (the cached factorisation stays
+    /// valid). Used to take rejected loop closures out before the final optimisation.
+    ///
+    /// # Panics
+    /// When `e` is not an edge index.
+    pub fn switch_off(&mut self, e: usize) {
+        self.edges[e].information = Matrix3::zeros();
+    }
+
     /// The poses, indexed by node.
     pub fn nodes(&self) -> &[Pose2] {
         &self.nodes

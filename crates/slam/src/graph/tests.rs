@@ -517,6 +517,27 @@ fn wrong_loop_edge_is_down_weighted() {
 }
 
 #[test]
+fn a_switched_off_edge_no_longer_acts() {
+    // The wrong loop under plain least squares bends the graph; switched off, the result is
+    // the graph without it, to the solver's precision.
+    let config = plain(Method::LevenbergMarquardt, 50);
+    let Square { mut graph, .. } = square(0);
+    graph.optimize(&config).unwrap();
+    let clean = graph.nodes().to_vec();
+    let (Square { mut graph, .. }, wrong) = square_with_wrong_loop(0, 5.0);
+    graph.switch_off(wrong);
+    graph.optimize(&config).unwrap();
+    let difference = graph
+        .nodes()
+        .iter()
+        .zip(&clean)
+        .map(|(a, b)| (a.translation() - b.translation()).norm())
+        .fold(0.0, f64::max);
+    assert!(difference < 1e-6, "{difference}");
+    assert_eq!(graph.edge_chi2(wrong), 0.0);
+}
+
+#[test]
 fn bad_input_is_an_error_not_a_panic() {
     let mut graph = PoseGraph::new();
     graph.add_node(Pose2::identity());
