@@ -154,9 +154,16 @@ fn equal_value_fusion_keeps_the_volume_and_fuses_a_single_scan() {
         "mean",
         "--json",
     ]);
+    // An unknown rule is refused by clap: its message on standard error, and with --json
+    // also as {"error": …} on standard output.
     assert_eq!(bad.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        err.contains("invalid value 'mean'") && err.contains("--fusion"),
+        "{err}"
+    );
     let json: serde_json::Value = serde_json::from_slice(&bad.stdout).unwrap();
-    assert!(json["error"].as_str().unwrap().contains("fusion rule"));
+    assert!(json["error"].as_str().unwrap().contains("'mean'"), "{json}");
 }
 
 #[test]
@@ -236,8 +243,10 @@ fn bad_input_exits_2_with_file_and_place() {
         "--json",
     ]);
     assert_eq!(bad_model.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&bad_model.stderr);
+    assert!(err.contains("invalid value 'cone'"), "{err}");
     let json: serde_json::Value = serde_json::from_slice(&bad_model.stdout).unwrap();
-    assert!(json["error"].as_str().unwrap().contains("cone"));
+    assert!(json["error"].as_str().unwrap().contains("cone"), "{json}");
 
     let bad_resolution = raypath(&["octree", graph.to_str().unwrap(), "--resolution", "-1"]);
     assert_eq!(bad_resolution.status.code(), Some(2));

@@ -40,3 +40,61 @@ fn man_pages_for_the_program_and_each_subcommand() {
     }
     assert!(dir.path().join("raypath.1").exists());
 }
+
+/// Choices (methods, models, presets, fusion rules, …) are value enums: clap refuses an
+/// unknown value with exit code 2 before any file is read, accepts the documented aliases,
+/// and `--help` lists the values.
+#[test]
+fn choices_are_checked_and_listed_by_clap() {
+    for (args, value) in [
+        (&["polylines", "none.log", "--method", "hough"][..], "hough"),
+        (
+            &[
+                "octree",
+                "none.graph",
+                "--resolution",
+                "0.1",
+                "--fusion",
+                "x",
+            ][..],
+            "x",
+        ),
+    ] {
+        let out = raypath(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(&format!("invalid value '{value}'")) && err.contains("possible values"),
+            "{args:?}: {err}"
+        );
+    }
+    // An alias passes clap; the missing file is the error.
+    let out = raypath(&[
+        "register",
+        "none.xyz",
+        "none.xyz",
+        "--kernel",
+        "geman-mcclure",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !err.contains("invalid value") && err.contains("none.xyz"),
+        "{err}"
+    );
+
+    let out = raypath(&["planes", "--help"]);
+    assert!(out.status.success());
+    let help = String::from_utf8(out.stdout).unwrap();
+    for value in [
+        "ppe",
+        "msac",
+        "peac",
+        "synpeb-0.5",
+        "segcomp",
+        "kitti",
+        "default",
+    ] {
+        assert!(help.contains(value), "{value} not in\n{help}");
+    }
+}

@@ -17,6 +17,17 @@ use serde_json::json;
 
 use super::Failure;
 
+/// `--model`: the intensity model to fit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ModelArg {
+    /// The thesis: I / I_ref(r, α), a look-up table (--range-step, --angle-step).
+    Lut,
+    /// Baseline: I / f(r), a polynomial f in the range (--degree).
+    Range,
+    /// Baseline: the raw intensity.
+    Raw,
+}
+
 /// Arguments of `raypath calibrate-intensity`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -25,9 +36,9 @@ pub struct Args {
     /// Where to write the model (JSON).
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
-    /// Model: lut (the thesis), range (polynomial baseline) or raw.
-    #[arg(long, default_value = "lut", value_name = "NAME")]
-    pub model: String,
+    /// Model.
+    #[arg(long, value_enum, default_value_t = ModelArg::Lut, value_name = "NAME")]
+    pub model: ModelArg,
     /// LUT range step, metres.
     #[arg(long, default_value_t = 0.01, value_name = "M")]
     pub range_step: f64,
@@ -49,8 +60,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         .map_err(|e| Failure::input(format!("{name}: {e}"), args.json))?;
     let samples =
         read_samples_csv(BufReader::new(file), &name).map_err(|e| Failure::input(e, args.json))?;
-    let model = match args.model.as_str() {
-        "lut" => {
+    let model = match args.model {
+        ModelArg::Lut => {
             let config = LutConfig {
                 range_step_m: args.range_step,
                 angle_step_rad: args.angle_step.to_radians(),
@@ -60,17 +71,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                     .map_err(|e| Failure::input(format!("{name}: {e}"), args.json))?,
             )
         }
-        "range" => IntensityCorrection::Range(
+        ModelArg::Range => IntensityCorrection::Range(
             RangePolynomial::fit(&samples, args.degree, 10f64.to_radians())
                 .map_err(|e| Failure::input(format!("{name}: {e}"), args.json))?,
         ),
-        "raw" => IntensityCorrection::Raw,
-        other => {
-            return Err(Failure::input(
-                format!("--model: expected lut, range or raw, got {other:?}"),
-                args.json,
-            ));
-        }
+        ModelArg::Raw => IntensityCorrection::Raw,
     };
     // How well the model reproduces its own samples (relative error of I_ref).
     let max_sample_error = samples

@@ -22,6 +22,30 @@ pub enum Compression {
     None,
 }
 
+/// `--to`: the output format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum To {
+    /// A CARMEN log (plain text).
+    Carmen,
+    /// A KITTI sequence directory.
+    Kitti,
+    /// A PCD file (one sweep) or a directory of PCD files (one per sweep).
+    Pcd,
+    /// A rosbag2 bag: an .mcap file, or a bag directory with metadata.yaml.
+    Rosbag2,
+}
+
+impl From<To> for Target {
+    fn from(to: To) -> Self {
+        match to {
+            To::Carmen => Target::Carmen,
+            To::Kitti => Target::Kitti,
+            To::Pcd => Target::Pcd,
+            To::Rosbag2 => Target::Rosbag2,
+        }
+    }
+}
+
 /// Arguments of `raypath convert`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -34,8 +58,8 @@ pub struct Args {
     /// when the name does not.
     pub output: PathBuf,
     /// The output format.
-    #[arg(long, value_name = "FORMAT", value_parser = ["carmen", "kitti", "pcd", "rosbag2"])]
-    pub to: Option<String>,
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub to: Option<To>,
     /// Chunk compression of a written bag.
     #[arg(long, value_enum, default_value_t = Compression::Zstd)]
     pub compression: Compression,
@@ -48,14 +72,8 @@ pub struct Args {
 
 /// Runs `raypath convert`.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let target = args
-        .to
-        .as_deref()
-        .map(str::parse::<Target>)
-        .transpose()
-        .map_err(|e| Failure::input(e, args.json))?;
     let options = ConvertOptions {
-        target,
+        target: args.to.map(Target::from),
         planar: args.source.planar_options(),
         sweeps: args.source.sweep_options(),
         bag: BagWriteOptions {

@@ -45,6 +45,33 @@ use super::source_args::{SourceArgs, is_bag, reference_track};
 /// CARMEN logs print the raw logger stamp with fewer digits), seconds.
 const MATCH_TOLERANCE_SECS: f64 = 2e-3;
 
+/// Values of `--model-override`: the sensor models `raypath_localizer` builds from a map.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ModelArg {
+    /// Decay-rate model (Schaefer 2020, Sec. 7.4), λ = H / R.
+    DecayRate,
+    /// Reflection model (Sec. 7.5.2), μ = H / (H + M).
+    Reflection,
+    /// Endpoint model: the likelihood field normalized per ray (Sec. 7.6.2).
+    Endpoint,
+    /// AMCL's likelihood field, unnormalized.
+    LikelihoodField,
+    /// Log-odds occupancy used as a reflection-type model.
+    LogOdds,
+}
+
+impl From<ModelArg> for ModelKind {
+    fn from(model: ModelArg) -> Self {
+        match model {
+            ModelArg::DecayRate => ModelKind::DecayRate,
+            ModelArg::Reflection => ModelKind::Reflection,
+            ModelArg::Endpoint => ModelKind::Endpoint,
+            ModelArg::LikelihoodField => ModelKind::LikelihoodField,
+            ModelArg::LogOdds => ModelKind::LogOdds,
+        }
+    }
+}
+
 /// Arguments of `raypath localize`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -65,10 +92,9 @@ pub struct Args {
     /// Random seed.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Use this model instead of the one the map names (decay-rate, reflection, endpoint,
-    /// likelihood-field, log-odds).
-    #[arg(long, value_name = "MODEL")]
-    pub model_override: Option<String>,
+    /// Use this model instead of the one the map names.
+    #[arg(long, value_enum, value_name = "MODEL")]
+    pub model_override: Option<ModelArg>,
     /// Traverse the grid exactly instead of using optical-depth tables (slower).
     #[arg(long)]
     pub exact: bool,
@@ -217,10 +243,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             json,
         ));
     };
-    let kind = match &args.model_override {
-        Some(name) => name
-            .parse::<ModelKind>()
-            .map_err(|e| Failure::input(format!("--model-override: {e}"), json))?,
+    let kind = match args.model_override {
+        Some(model) => model.into(),
         None => match map.kind {
             MapKind::Statistics | MapKind::DecayRate => ModelKind::DecayRate,
             MapKind::Reflection => ModelKind::Reflection,

@@ -23,6 +23,15 @@ pub mod source_args;
 
 use std::process::ExitCode;
 
+/// The command-line spelling of a choice: the name clap accepts and `--help` lists, for
+/// messages and JSON output.
+pub fn choice_name<T: clap::ValueEnum>(value: &T) -> String {
+    value
+        .to_possible_value()
+        .map(|v| v.get_name().to_owned())
+        .unwrap_or_default()
+}
+
 /// Why a subcommand failed, and how to report it.
 pub struct Failure {
     /// The message (for input errors: `file:place: reason`).

@@ -42,6 +42,25 @@ use super::Failure;
 use super::record::{RecordArgs, Recording, cube_entities};
 use super::source_args::{SourceArgs, is_bag, sweep_poses};
 
+/// `--model`: the inverse sensor model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ModelArg {
+    /// Beam-based: the cells a beam traverses are updated as free, its end cell as occupied.
+    Beam,
+    /// Beam-end-point: only the end cell is updated (occupied); free space is not modelled.
+    Endpoint,
+}
+
+/// `--fusion`: which cells fuse.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FusionArg {
+    /// The thesis: only clamped cells fuse.
+    Clamped,
+    /// Ours: cells with equal log-odds fuse, split again on partial updates; the map stays
+    /// exact.
+    Equal,
+}
+
 /// Arguments of `raypath octree`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -52,9 +71,9 @@ pub struct Args {
     /// Base resolution r, metres.
     #[arg(long, value_name = "R")]
     pub resolution: f64,
-    /// Inverse sensor model: beam (beam-based) or endpoint (beam-end-point).
-    #[arg(long, default_value = "beam", value_name = "NAME")]
-    pub model: String,
+    /// Inverse sensor model.
+    #[arg(long, value_enum, default_value_t = ModelArg::Beam, value_name = "NAME")]
+    pub model: ModelArg,
     /// M: most entries per R-tree node (d = ⌈0.4·M⌉).
     #[arg(long, default_value_t = 8, value_name = "M")]
     pub max_entries: usize,
@@ -64,10 +83,9 @@ pub struct Args {
     /// Use at most this many scans.
     #[arg(long, value_name = "N")]
     pub scans: Option<usize>,
-    /// Fusion rule: clamped (the thesis: only clamped cells fuse) or equal (ours: cells with
-    /// equal log-odds fuse, split again on partial updates; the map stays exact).
-    #[arg(long, default_value = "clamped", value_name = "RULE")]
-    pub fusion: String,
+    /// Fusion rule.
+    #[arg(long, value_enum, default_value_t = FusionArg::Clamped, value_name = "RULE")]
+    pub fusion: FusionArg,
     /// Fuse after every this many scans (1: the thesis; larger: fewer splits of fused cells
     /// on a moving sensor; pending fusions run after the last scan).
     #[arg(long, default_value_t = 1, value_name = "N")]
@@ -169,25 +187,13 @@ fn write_map(grid: &RtreeGrid, out: &Path, json: bool) -> Result<(), Failure> {
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let model = match args.model.as_str() {
-        "beam" => SensorModel::BeamBased,
-        "endpoint" => SensorModel::BeamEndPoint,
-        other => {
-            return Err(Failure::input(
-                format!("unknown model {other:?}; choose beam or endpoint"),
-                args.json,
-            ));
-        }
+    let model = match args.model {
+        ModelArg::Beam => SensorModel::BeamBased,
+        ModelArg::Endpoint => SensorModel::BeamEndPoint,
     };
-    let fusion_rule = match args.fusion.as_str() {
-        "clamped" => FusionRule::Clamped,
-        "equal" => FusionRule::EqualValue,
-        other => {
-            return Err(Failure::input(
-                format!("unknown fusion rule {other:?}; choose clamped or equal"),
-                args.json,
-            ));
-        }
+    let fusion_rule = match args.fusion {
+        FusionArg::Clamped => FusionRule::Clamped,
+        FusionArg::Equal => FusionRule::EqualValue,
     };
     if let Some(out) = &args.out {
         let name = out.to_string_lossy().to_lowercase();
@@ -234,8 +240,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "scans": scans.len(),
             "points": points,
             "resolution_m": args.resolution,
-            "model": args.model,
-            "fusion": args.fusion,
+            "model": super::choice_name(&args.model),
+            "fusion": super::choice_name(&args.fusion),
             "fusion_interval_scans": config.fusion_interval_scans,
             "max_entries": config.max_entries,
             "min_entries": config.min_entries,
@@ -259,8 +265,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             args.input.display(),
             scans.len(),
             args.resolution,
-            args.model,
-            args.fusion,
+            super::choice_name(&args.model),
+            super::choice_name(&args.fusion),
             config.max_entries
         );
         println!(

@@ -40,6 +40,52 @@ use super::Failure;
 use super::record::{RecordArgs, Recording, label_color, plane_entity};
 use super::source_args::{SourceArgs, is_bag};
 
+/// `--method`: the plane extractor.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodArg {
+    /// PPE: probabilistic plane extraction (Schaefer 2020, ch. 11).
+    Ppe,
+    /// Baseline: iterative MSAC with its SynPEB parameters.
+    Msac,
+    /// Baseline: PEAC-style block graph (Feng et al. 2014) with its SynPEB parameters.
+    Peac,
+}
+
+/// `--preset`: the PPE parameters (`raypath_planes::PpeParams::preset`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum PresetArg {
+    /// SynPEB-style scans, σ = 2 cm (the same as synpeb-2.0).
+    Synpeb,
+    /// SynPEB noise level σ = 0 cm.
+    #[value(name = "synpeb-0.0")]
+    Synpeb00,
+    /// SynPEB noise level σ = 0.5 cm.
+    #[value(name = "synpeb-0.5")]
+    Synpeb05,
+    /// SynPEB noise level σ = 1 cm.
+    #[value(name = "synpeb-1.0")]
+    Synpeb10,
+    /// SynPEB noise level σ = 2 cm.
+    #[value(name = "synpeb-2.0")]
+    Synpeb20,
+    /// SynPEB noise level σ = 4 cm.
+    #[value(name = "synpeb-4.0")]
+    Synpeb40,
+    /// The SegComp Perceptron scans (√e = d = 20 mm).
+    Segcomp,
+    /// Velodyne HDL-64E range images (tuned on KITTI).
+    Kitti,
+    /// The library defaults (e = 0.01 m², no neighbour filter).
+    Default,
+}
+
+impl PresetArg {
+    /// The preset's parameters.
+    fn params(self) -> Option<PpeParams> {
+        PpeParams::preset(&super::choice_name(&self))
+    }
+}
+
 /// Arguments of `raypath planes`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -50,13 +96,12 @@ pub struct Args {
     /// Bags and Ouster captures: the 0-based index of the sweep (frame) to use.
     #[arg(long, default_value_t = 0, value_name = "I")]
     pub frame_index: usize,
-    /// Extraction method: ppe (default), msac or peac.
-    #[arg(long, default_value = "ppe", value_name = "NAME")]
-    pub method: String,
-    /// PPE parameter preset: synpeb (default; σ = 2 cm), synpeb-0.0, synpeb-0.5,
-    /// synpeb-1.0, synpeb-2.0, synpeb-4.0, segcomp or default.
-    #[arg(long, default_value = "synpeb", value_name = "NAME")]
-    pub preset: String,
+    /// Extraction method.
+    #[arg(long, value_enum, default_value_t = MethodArg::Ppe, value_name = "NAME")]
+    pub method: MethodArg,
+    /// PPE parameter preset (the baselines use their SynPEB parameters).
+    #[arg(long, value_enum, default_value_t = PresetArg::Synpeb, value_name = "NAME")]
+    pub preset: PresetArg,
     /// Override the preset's stopping rule e (largest error increment per step, m²).
     #[arg(long, value_name = "M2")]
     pub max_increment: Option<f64>,
@@ -171,15 +216,16 @@ fn record(
 
 /// Runs the command.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let Some(mut params) = PpeParams::preset(&args.preset) else {
-        return Err(Failure::input(
-            format!(
-                "unknown preset {:?}; choose one of {}",
-                args.preset,
-                PpeParams::PRESETS.join(", ")
+    let Some(mut params) = args.preset.params() else {
+        // Unreachable: the test below resolves every preset.
+        return Err(Failure {
+            message: format!(
+                "preset {}: not known to raypath_planes",
+                super::choice_name(&args.preset)
             ),
-            args.json,
-        ));
+            bad_input: false,
+            json: args.json,
+        });
     };
     if let Some(e) = args.max_increment {
         params.max_increment_m2 = e;
@@ -190,29 +236,23 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     params
         .validate()
         .map_err(|e| Failure::input(e, args.json))?;
-    if !["ppe", "msac", "peac"].contains(&args.method.as_str()) {
-        return Err(Failure::input(
-            format!("unknown method {:?}; choose ppe, msac or peac", args.method),
-            args.json,
-        ));
-    }
     let mut recording = Recording::open(&args.record, args.json)?;
     let (cloud, stamp) = read_scan(args)?;
     let started = Instant::now();
-    let result = match args.method.as_str() {
-        "msac" | "peac" => {
+    let result = match args.method {
+        MethodArg::Msac | MethodArg::Peac => {
             let points: Vec<nalgebra::Vector3<f64>> = cloud
                 .points
                 .iter()
                 .map(|p| p.coords.cast::<f64>())
                 .collect();
-            if args.method == "msac" {
+            if args.method == MethodArg::Msac {
                 msac(&points, cloud.width, cloud.height, &MsacParams::synpeb())
             } else {
                 peac(&points, cloud.width, cloud.height, &PeacParams::synpeb())
             }
         }
-        _ => extract(&cloud, &params),
+        MethodArg::Ppe => extract(&cloud, &params),
     };
     let seg =
         result.map_err(|e| Failure::input(format!("{}: {e}", args.scan.display()), args.json))?;
@@ -245,8 +285,12 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                        "points": p.index.len(), "rmse": p.fit.rmse_m()})
             })
             .collect();
+        let (method, preset) = (
+            super::choice_name(&args.method),
+            super::choice_name(&args.preset),
+        );
         let mut doc = json!({"scan": args.scan.display().to_string(), "width": cloud.width,
-            "height": cloud.height, "method": args.method, "preset": args.preset, "planes": planes,
+            "height": cloud.height, "method": method, "preset": preset, "planes": planes,
             "rmse": seg.rmse_m(), "seconds": seconds});
         super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
@@ -277,4 +321,23 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         super::record::finish(recording, None)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::ValueEnum;
+
+    use super::*;
+
+    #[test]
+    fn the_presets_are_those_of_raypath_planes() {
+        let names: Vec<String> = PresetArg::value_variants()
+            .iter()
+            .map(|p| {
+                assert!(p.params().is_some(), "{p:?}");
+                super::super::choice_name(p)
+            })
+            .collect();
+        assert_eq!(names, PpeParams::PRESETS);
+    }
 }

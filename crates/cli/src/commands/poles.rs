@@ -75,9 +75,9 @@ pub struct Common {
     /// A KITTI sequence directory, an NCLT session directory or a rosbag2 bag (directory with
     /// metadata.yaml, or .mcap file) with PointCloud2.
     pub sequence: PathBuf,
-    /// Parameter preset: nclt or kitti (default: from the layout).
-    #[arg(long, value_name = "NAME")]
-    pub preset: Option<String>,
+    /// Parameter preset (default: from the layout).
+    #[arg(long, value_enum, value_name = "NAME")]
+    pub preset: Option<PresetArg>,
     /// Use at most this many scans (from `--from`).
     #[arg(long, value_name = "N")]
     pub max_scans: Option<usize>,
@@ -111,6 +111,15 @@ pub enum SweepTimingArg {
     /// Rays from the scan's origin.
     Origin,
     /// Rays from the sensor's position at each firing, KITTI's sweep timing.
+    Kitti,
+}
+
+/// Values of `--preset`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum PresetArg {
+    /// The NCLT settings (Schaefer 2020, §12.5.1): 0.2 m voxels.
+    Nclt,
+    /// The KITTI settings (Schaefer 2020, §12.5.2): 0.1 m voxels.
     Kitti,
 }
 
@@ -197,15 +206,9 @@ fn open(common: &Common) -> Result<(Drive, Preset, std::ops::Range<usize>), Fail
         }
     };
     drive.sweep_timing = kitti_timing.then(raypath_poles::SweepTiming::kitti);
-    let preset = match common.preset.as_deref() {
-        Some("nclt") => Preset::nclt(),
-        Some("kitti") => Preset::kitti(),
-        Some(other) => {
-            return Err(Failure::input(
-                format!("unknown preset {other:?}; choose nclt or kitti"),
-                json,
-            ));
-        }
+    let preset = match common.preset {
+        Some(PresetArg::Nclt) => Preset::nclt(),
+        Some(PresetArg::Kitti) => Preset::kitti(),
         None => match drive.format {
             DriveFormat::Kitti => Preset::kitti(),
             DriveFormat::Nclt => Preset::nclt(),
@@ -229,8 +232,8 @@ fn open(common: &Common) -> Result<(Drive, Preset, std::ops::Range<usize>), Fail
 }
 
 fn preset_name(common: &Common, drive: &Drive) -> &'static str {
-    match (common.preset.as_deref(), drive.format) {
-        (Some("nclt"), _) | (None, DriveFormat::Nclt) => "nclt",
+    match (common.preset, drive.format) {
+        (Some(PresetArg::Nclt), _) | (None, DriveFormat::Nclt) => "nclt",
         _ => "kitti",
     }
 }

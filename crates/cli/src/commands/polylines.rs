@@ -33,6 +33,28 @@ use super::Failure;
 use super::record::{RecordArgs, Recording, polyline_entities};
 use super::source_args::SourceArgs;
 
+/// `--method`: the polyline extractor.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodArg {
+    /// PLE: maximum-likelihood polylines (Schaefer 2020, ch. 10); PLE+ with `--optimize`.
+    Ple,
+    /// VVL baseline: Visvalingam line simplification.
+    Vvl,
+    /// IEF baseline: iterative end-point fit.
+    Ief,
+    /// SAM baseline: split-and-merge.
+    Sam,
+}
+
+/// `--solver`: the vertex optimizer of PLE+.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SolverArg {
+    /// Levenberg–Marquardt.
+    Lm,
+    /// Nelder–Mead, as the thesis.
+    Nm,
+}
+
 /// Arguments of `raypath polylines`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -56,12 +78,12 @@ pub struct Args {
     /// Optimize the vertices after extraction (PLE+).
     #[arg(long)]
     pub optimize: bool,
-    /// Extractor: ple (default), vvl, ief or sam (baselines). `--optimize` applies to ple.
-    #[arg(long, default_value = "ple", value_name = "NAME")]
-    pub method: String,
-    /// PLE+ solver: lm (Levenberg–Marquardt, default) or nm (Nelder–Mead, as the thesis).
-    #[arg(long, default_value = "lm", value_name = "NAME")]
-    pub solver: String,
+    /// Extractor: PLE or a baseline. `--optimize` applies to ple.
+    #[arg(long, value_enum, default_value_t = MethodArg::Ple, value_name = "NAME")]
+    pub method: MethodArg,
+    /// PLE+ solver.
+    #[arg(long, value_enum, default_value_t = SolverArg::Lm, value_name = "NAME")]
+    pub solver: SolverArg,
     /// l_max: longest edge between neighbouring endpoints, metres.
     #[arg(long, default_value_t = 1.0, value_name = "M")]
     pub max_edge: f64,
@@ -91,34 +113,25 @@ struct Extracted {
 }
 
 fn config(args: &Args) -> Result<PolylineConfig, Failure> {
-    let method = match (args.method.as_str(), args.optimize) {
-        ("ple", false) => Method::Ple,
-        ("ple", true) => Method::PlePlus,
-        ("vvl", false) => Method::Vvl,
-        ("ief", false) => Method::Ief,
-        ("sam", false) => Method::Sam,
-        ("vvl" | "ief" | "sam", true) => {
+    let method = match (args.method, args.optimize) {
+        (MethodArg::Ple, false) => Method::Ple,
+        (MethodArg::Ple, true) => Method::PlePlus,
+        (MethodArg::Vvl, false) => Method::Vvl,
+        (MethodArg::Ief, false) => Method::Ief,
+        (MethodArg::Sam, false) => Method::Sam,
+        (other @ (MethodArg::Vvl | MethodArg::Ief | MethodArg::Sam), true) => {
             return Err(Failure::input(
-                format!("--optimize applies to ple only, not {}", args.method),
-                args.json,
-            ));
-        }
-        (other, _) => {
-            return Err(Failure::input(
-                format!("unknown method {other:?}; choose ple, vvl, ief or sam"),
+                format!(
+                    "--optimize applies to ple only, not {}",
+                    super::choice_name(&other)
+                ),
                 args.json,
             ));
         }
     };
-    let optimizer = match args.solver.as_str() {
-        "lm" => Optimizer::LEVENBERG_MARQUARDT,
-        "nm" => Optimizer::NELDER_MEAD,
-        other => {
-            return Err(Failure::input(
-                format!("unknown solver {other:?}; choose lm or nm"),
-                args.json,
-            ));
-        }
+    let optimizer = match args.solver {
+        SolverArg::Lm => Optimizer::LEVENBERG_MARQUARDT,
+        SolverArg::Nm => Optimizer::NELDER_MEAD,
     };
     let config = PolylineConfig {
         method,

@@ -44,6 +44,18 @@ use serde_json::{Value, json};
 use super::Failure;
 use super::source_args::{SourceArgs, is_bag};
 
+/// `--kernel`: the robust kernel of the point-to-plane residuals.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum KernelArg {
+    /// Geman–McClure (KISS-ICP's kernel; also spelled geman-mcclure).
+    #[value(alias = "geman-mcclure")]
+    Gm,
+    /// Huber: linear beyond the scale.
+    Huber,
+    /// None: plain least squares.
+    None,
+}
+
 /// Arguments of `raypath register`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -67,9 +79,9 @@ pub struct Args {
     /// Drop returns closer than this to the sensor, metres.
     #[arg(long, default_value_t = 0.0, value_name = "M")]
     pub min_range: f64,
-    /// Robust kernel: gm (Geman–McClure), huber or none.
-    #[arg(long, default_value = "gm", value_name = "NAME")]
-    pub kernel: String,
+    /// Robust kernel.
+    #[arg(long, value_enum, default_value_t = KernelArg::Gm, value_name = "NAME")]
+    pub kernel: KernelArg,
     /// Print one JSON document on standard output.
     #[arg(long)]
     pub json: bool,
@@ -79,16 +91,10 @@ pub struct Args {
 }
 
 fn config(args: &Args) -> Result<RegistrationConfig, Failure> {
-    let kernel = match args.kernel.as_str() {
-        "gm" | "geman-mcclure" => Kernel::GemanMcClure,
-        "huber" => Kernel::Huber,
-        "none" => Kernel::None,
-        other => {
-            return Err(Failure::input(
-                format!("unknown kernel {other:?}; choose gm, huber or none"),
-                args.json,
-            ));
-        }
+    let kernel = match args.kernel {
+        KernelArg::Gm => Kernel::GemanMcClure,
+        KernelArg::Huber => Kernel::Huber,
+        KernelArg::None => Kernel::None,
     };
     let config = RegistrationConfig {
         voxel_size_m: args.voxel_size,

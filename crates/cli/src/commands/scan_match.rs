@@ -43,15 +43,36 @@ use super::Failure;
 use super::record::{RecordArgs, Recording};
 use super::source_args::{SourceArgs, reference_track};
 
+/// `--mode`: the residual of the matcher.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ModeArg {
+    /// Occupancy only: plain Hector.
+    Occupancy,
+    /// Relative reflectivity only: Khan's intensity-based Hector (needs --lut).
+    Reflectivity,
+    /// Both residuals (needs --lut).
+    Combined,
+}
+
+impl From<ModeArg> for ResidualMode {
+    fn from(mode: ModeArg) -> Self {
+        match mode {
+            ModeArg::Occupancy => ResidualMode::Occupancy,
+            ModeArg::Reflectivity => ResidualMode::Reflectivity,
+            ModeArg::Combined => ResidualMode::Combined,
+        }
+    }
+}
+
 /// Arguments of `raypath scan-match`.
 #[derive(clap::Args)]
 pub struct Args {
     /// A CARMEN log (plain, .gz or .bz2): FLASER scans, or ROBOTLASER1 with remissions; or a
     /// rosbag2 bag (directory with metadata.yaml, or .mcap file) with LaserScan.
     pub log: PathBuf,
-    /// Residual: occupancy (plain Hector), reflectivity (Khan) or combined.
-    #[arg(long, default_value = "occupancy", value_name = "MODE")]
-    pub mode: String,
+    /// Residual.
+    #[arg(long, value_enum, default_value_t = ModeArg::Occupancy, value_name = "MODE")]
+    pub mode: ModeArg,
     /// Intensity model JSON from `raypath calibrate-intensity` (needed by reflectivity and
     /// combined).
     #[arg(long, value_name = "FILE")]
@@ -110,15 +131,7 @@ fn failure(message: impl std::fmt::Display, json: bool) -> Failure {
 }
 
 fn config(args: &Args) -> Result<MatcherConfig, Failure> {
-    let Some(mode) = ResidualMode::parse(&args.mode) else {
-        return Err(Failure::input(
-            format!(
-                "--mode: expected occupancy, reflectivity or combined, got {:?}",
-                args.mode
-            ),
-            args.json,
-        ));
-    };
+    let mode = ResidualMode::from(args.mode);
     let odometry_sigma = match args.odometry_prior.as_deref() {
         None => None,
         Some(&[a, b, c]) => Some([a, b, c]),

@@ -23,6 +23,24 @@ use serde_json::json;
 use super::Failure;
 use super::source_args::{SourceArgs, reference_track};
 
+/// `--split`: which scans build the maps and which are scored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SplitArg {
+    /// Even scans build the maps, odd scans are scored.
+    Alternate,
+    /// The first half builds the maps, the second half is scored.
+    Halves,
+}
+
+impl From<SplitArg> for Split {
+    fn from(split: SplitArg) -> Self {
+        match split {
+            SplitArg::Alternate => Split::Alternate,
+            SplitArg::Halves => Split::Halves,
+        }
+    }
+}
+
 /// Arguments of `raypath score-model`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -39,9 +57,9 @@ pub struct Args {
     /// Seed of the pose samples of the inverse KL.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Mapping / test split: `alternate` (even scans map, odd scans are scored) or `halves`.
-    #[arg(long, default_value = "alternate", value_name = "NAME")]
-    pub split: String,
+    /// Mapping / test split.
+    #[arg(long, value_enum, default_value_t = SplitArg::Alternate, value_name = "NAME")]
+    pub split: SplitArg,
     /// Score every k-th beam of a test scan.
     #[arg(long, default_value_t = 1, value_name = "K")]
     pub beam_step: usize,
@@ -61,15 +79,9 @@ pub struct Args {
 
 /// Runs `raypath score-model`.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let split = Split::from_name(&args.split).ok_or_else(|| {
-        Failure::input(
-            format!("unknown split {:?}; choose alternate or halves", args.split),
-            args.json,
-        )
-    })?;
     let config = ScoringConfig {
         resolution_m: args.resolution,
-        split,
+        split: args.split.into(),
         max_range_m: args.max_range,
         poses_per_scan: args.poses,
         seed: args.seed,
