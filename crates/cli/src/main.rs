@@ -11,7 +11,9 @@
 //! ```
 //!
 //! Every subcommand prints a human-readable report, or with `--json` one JSON document on
-//! standard output for scripts. Errors go to standard error as `error: <file>:<place>: <reason>`
+//! standard output for scripts. Long commands draw a progress bar on standard error when it
+//! is a terminal; `--quiet` (`-q`) silences bars, warnings and notes, `-v` adds the time of
+//! each stage. Errors go to standard error as `error: <file>:<place>: <reason>`
 //! (and, with `--json`, as `{"error": "..."}` on standard output); the exit code is 2 for bad
 //! input and 1 for other failures.
 
@@ -30,6 +32,12 @@ use clap::{CommandFactory, Parser, Subcommand};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// No progress bars, warnings or notes on standard error (errors are still printed).
+    #[arg(short, long, global = true, conflicts_with = "verbose")]
+    quiet: bool,
+    /// Also print how long each stage took on standard error.
+    #[arg(short, long, global = true, action = clap::ArgAction::Count)]
+    verbose: u8,
 }
 
 #[derive(Subcommand)]
@@ -99,6 +107,7 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(error) => return parse_failure(&error),
     };
+    commands::console::set(cli.quiet, cli.verbose);
     let result = match &cli.command {
         Command::Info(args) => commands::info::run(args),
         Command::Convert(args) => commands::convert::run(args),
@@ -147,13 +156,16 @@ fn parse_failure(error: &clap::Error) -> ExitCode {
     }
     let _ = error.print();
     if std::env::args().skip(1).any(|a| a == "--json") {
-        let message = error.render().to_string();
-        let first = message
+        // The message up to the first blank line (before the usage hint), on one line.
+        let rendered = error.render().to_string();
+        let message: Vec<&str> = rendered
             .lines()
-            .next()
-            .unwrap_or_default()
-            .trim_start_matches("error: ");
-        println!("{}", serde_json::json!({ "error": first }));
+            .take_while(|l| !l.trim().is_empty())
+            .map(str::trim)
+            .collect();
+        let message = message.join(" ");
+        let message = message.trim_start_matches("error: ");
+        println!("{}", serde_json::json!({ "error": message }));
     }
     ExitCode::from(2)
 }

@@ -268,3 +268,32 @@ fn bad_input_exits_2_with_file_and_place() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("bad.xyz") && err.contains('2'), "{err}");
 }
+
+#[test]
+fn quiet_and_verbose_are_global_flags() {
+    let dir = tempfile::tempdir().unwrap();
+    let graph = room_graph(dir.path(), 2);
+    let graph = graph.to_str().unwrap();
+    // -v (before or after the subcommand) adds the stage times on standard error.
+    for args in [
+        ["-v", "octree", graph, "--resolution", "0.2", "--json"],
+        ["octree", graph, "--resolution", "0.2", "--json", "-v"],
+    ] {
+        let out = raypath(&args);
+        assert!(out.status.success(), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("insertion and fusion: "), "{args:?}: {err}");
+        json_of(&out);
+    }
+    // --quiet: nothing on standard error for a run without errors; the report is unchanged.
+    let out = raypath(&["octree", graph, "--resolution", "0.2", "--quiet"]);
+    assert!(out.status.success());
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(!out.stdout.is_empty());
+    let both = raypath(&["octree", graph, "--resolution", "0.2", "-q", "-v"]);
+    assert_eq!(both.status.code(), Some(2));
+}

@@ -331,6 +331,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         particles: args.particles,
         ..TrackConfig::default()
     };
+    let spinner = super::console::spinner("localization");
+    let started = std::time::Instant::now();
     let result = track_planar(
         &steps,
         &measurement,
@@ -339,6 +341,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         args.seed,
     )
     .map_err(|e| Failure::input(format!("{}: {e}", args.log.display()), json))?;
+    spinner.finish_and_clear();
+    super::console::stage("localization", started);
 
     if let Some(out) = &args.out {
         write_tum(out, &result.estimates)

@@ -440,10 +440,10 @@ fn dbow_vocabulary(
                 .map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))?
         }
         None => {
-            eprintln!(
-                "warning: no --vocabulary: training the DBoW vocabulary on the input itself; \
-                 this is not the offline protocol (a vocabulary from independent images) and \
-                 flatters DBoW"
+            super::console::warn(
+                "no --vocabulary: training the DBoW vocabulary on the input itself; this is \
+                 not the offline protocol (a vocabulary from independent images) and flatters \
+                 DBoW",
             );
             let place =
                 |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()), json);

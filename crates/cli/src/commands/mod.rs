@@ -1,6 +1,7 @@
 //! One module per subcommand, plus the shared failure type.
 
 pub mod calibrate_intensity;
+pub mod console;
 pub mod convert;
 pub mod dct_map;
 pub mod info;

@@ -215,10 +215,14 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     check_lattice(args, &scans)?;
     let points: usize = scans.iter().map(|(_, c)| c.num_valid()).sum();
     let started = Instant::now();
+    let bar = super::console::progress(scans.len(), "insertion");
     for (pose, cloud) in &scans {
         grid.insert_cloud(pose, cloud);
+        bar.inc(1);
     }
+    bar.finish_and_clear();
     grid.fuse_pending();
+    super::console::stage("insertion and fusion", started);
     let insert_secs = started.elapsed().as_secs_f64();
     grid.shrink_to_fit();
     let started = Instant::now();
@@ -354,11 +358,11 @@ fn record(
     cloud.intensity = Some(occupied.iter().map(|c| c.probability as f32).collect());
     recording.points(topic::MAP_POINTS, end, frame::MAP, &cloud, None)?;
     if occupied.len() > MAX_CUBES {
-        eprintln!(
-            "note: --record: {} occupied leaves; /octree holds the {MAX_CUBES} largest as cubes, \
+        super::console::note(format!(
+            "--record: {} occupied leaves; /octree holds the {MAX_CUBES} largest as cubes, \
              /map_points the centres of all",
             occupied.len()
-        );
+        ));
         let volume = |c: &Cuboid| (0..3).map(|a| c.max_m[a] - c.min_m[a]).product::<f64>();
         occupied.sort_by(|a, b| volume(b).total_cmp(&volume(a)));
         occupied.truncate(MAX_CUBES);

@@ -423,7 +423,9 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
     };
     let mut runs: Vec<RunResult> = Vec::with_capacity(args.runs);
     let mut finals = Vec::with_capacity(args.runs);
+    let bar = super::console::progress(args.runs, "localization runs");
     for r in 0..args.runs {
+        bar.inc(1);
         let (track, updates, update_secs) = filter_run(
             &drive,
             range.clone(),

@@ -203,7 +203,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let scans = read_scans(args)?;
     let several = scans.len() > 1;
     let mut results = Vec::with_capacity(scans.len());
+    let bar = super::console::progress(scans.len(), "polylines");
     for (index, frame) in &scans {
+        bar.inc(1);
         let scan = &frame.scan;
         let place = || format!("{}: scan {index}", args.log.display());
         let map = extract(scan, &config)

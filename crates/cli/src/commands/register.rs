@@ -266,7 +266,9 @@ fn sequence(args: &Args, config: RegistrationConfig) -> Result<(), Failure> {
     })
     .map_err(|e| Failure::input(e, args.json))?;
     let mut steps = Vec::with_capacity(n);
+    let bar = super::console::progress(n, "registration");
     for k in 0..n {
+        bar.inc(1);
         let cloud = sweeps.sweep(k).map_err(bad)?;
         let started = Instant::now();
         let step = odometry.register_frame(&cloud).map_err(|e| {

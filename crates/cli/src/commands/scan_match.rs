@@ -327,8 +327,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     };
     let use_odometry = args.odometry || args.odometry_prior.is_some();
     let start = Instant::now();
+    let spinner = super::console::spinner("scan matching");
     let (matcher, results) = run_matcher(&scans, config, &filter, lut.as_ref(), use_odometry)
         .map_err(|e| failure(e, args.json))?;
+    spinner.finish_and_clear();
+    super::console::stage("scan matching", start);
     let time_s = start.elapsed().as_secs_f64();
     let poses: Vec<Pose2> = results.iter().map(|r| r.world_from_sensor).collect();
     if let Some(out) = &args.out {

@@ -66,15 +66,13 @@ pub struct Args {
 
 /// Runs `raypath simulate`.
 pub fn run(args: &Args) -> Result<(), Failure> {
+    let bar = super::console::progress(0, "simulation");
     let progress = |done: u64, total: u64| {
-        if !args.json && total > 0 && (done == total || done % (total / 20).max(1) == 0) {
-            eprint!("\r{done}/{total}");
-            if done == total {
-                eprintln!();
-            }
-        }
+        bar.set_length(total);
+        bar.set_position(done);
     };
     let result = generate(args, &progress);
+    bar.finish_and_clear();
     let set = result.map_err(|e| match e {
         SimError::InvalidParameter { .. } | SimError::Io(_) => Failure::input(e, args.json),
         other => Failure {

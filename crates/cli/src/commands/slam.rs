@@ -173,12 +173,16 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     if let Some(lut) = lut {
         slam = slam.with_correction(lut);
     }
+    let bar = super::console::progress(frames.len(), "slam");
     for (k, frame) in frames.iter().enumerate() {
         slam.process(frame).map_err(|e| {
             Failure::input(format!("{}: scan {k}: {e}", args.log.display()), args.json)
         })?;
+        bar.inc(1);
     }
+    bar.finish_and_clear();
     let output = slam.finish().map_err(|e| failure(e, args.json))?;
+    super::console::stage("slam", started);
     let seconds = started.elapsed().as_secs_f64();
     let outputs = write_outputs(args, &frames, &output)?;
     let map = rebuild_map(args, &outputs.corrected)?;

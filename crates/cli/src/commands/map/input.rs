@@ -153,7 +153,9 @@ fn read_sweeps(
         ));
     };
     if odometry {
-        eprintln!("warning: {name}: no reference poses; mapping with the odometry poses");
+        crate::commands::console::warn(format!(
+            "{name}: no reference poses; mapping with the odometry poses"
+        ));
     }
     let mut sweeps = Vec::with_capacity(poses.len());
     for (i, pose) in poses.iter().enumerate() {

@@ -100,10 +100,10 @@ fn occupied_voxels(stats: &DenseStats3, picture: MapPicture) -> PointCloud {
         .collect();
     let step = occupied.len().div_ceil(MAX_VOXELS).max(1);
     if step > 1 {
-        eprintln!(
-            "note: --record: {} occupied voxels; recording every {step}-th",
+        crate::commands::console::note(format!(
+            "--record: {} occupied voxels; recording every {step}-th",
             occupied.len()
-        );
+        ));
     }
     let mut points = Vec::with_capacity(occupied.len() / step + 1);
     let mut intensity = Vec::with_capacity(points.capacity());

@@ -1,0 +1,75 @@
+//! What the program says on standard error besides its errors: progress bars, warnings and
+//! notes, and with `-v` the time each stage took. `--quiet` silences all of it (errors are
+//! still printed); progress bars are drawn only when standard error is a terminal, so logs
+//! and pipes stay clean.
+
+use std::sync::atomic::{AtomicU8, Ordering};
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressFinish, ProgressStyle};
+
+/// 0 = `--quiet`, 1 = normal, 2 and more = `-v`.
+static LEVEL: AtomicU8 = AtomicU8::new(1);
+
+/// Sets the verbosity from the global flags (once, in `main`).
+pub fn set(quiet: bool, verbose: u8) {
+    let level = if quiet { 0 } else { 1 + verbose.min(2) };
+    LEVEL.store(level, Ordering::Relaxed);
+}
+
+fn level() -> u8 {
+    LEVEL.load(Ordering::Relaxed)
+}
+
+/// A progress bar over `len` steps labelled `what` on standard error; hidden under
+/// `--quiet` and when standard error is not a terminal; cleared when dropped (also on an
+/// early return with an error).
+pub fn progress(len: usize, what: &str) -> ProgressBar {
+    let target = if level() == 0 {
+        ProgressDrawTarget::hidden()
+    } else {
+        ProgressDrawTarget::stderr()
+    };
+    let bar = ProgressBar::with_draw_target(Some(len as u64), target)
+        .with_finish(ProgressFinish::AndClear);
+    if let Ok(style) =
+        ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} ({per_sec}, {eta} left)")
+    {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_message(what.to_owned());
+    bar
+}
+
+/// `warning: …` on standard error, unless `--quiet`.
+pub fn warn(message: impl std::fmt::Display) {
+    if level() > 0 {
+        eprintln!("warning: {message}");
+    }
+}
+
+/// `note: …` on standard error, unless `--quiet`.
+pub fn note(message: impl std::fmt::Display) {
+    if level() > 0 {
+        eprintln!("note: {message}");
+    }
+}
+
+/// With `-v`: `<stage>: <seconds> s` since `started` on standard error.
+pub fn stage(stage: &str, started: Instant) {
+    if level() >= 2 {
+        eprintln!("{stage}: {:.3} s", started.elapsed().as_secs_f64());
+    }
+}
+
+/// A spinner with the elapsed time for a long stage without a step count (a library call
+/// that runs to the end); hidden like [`progress`]. Finish it with `finish_and_clear`.
+pub fn spinner(what: &str) -> ProgressBar {
+    let bar = progress(0, what);
+    bar.set_length(0);
+    if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} ({elapsed})") {
+        bar.set_style(style);
+    }
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar
+}
