@@ -520,3 +520,170 @@ fn report(
         headline: None,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scores(cells: [usize; 4], bits: [f64; 4]) -> Vec<Score> {
+        cells
+            .iter()
+            .zip(bits)
+            .map(|(&cells, entropy_bits)| Score {
+                cells,
+                entropy_bits,
+            })
+            .collect()
+    }
+
+    /// The last cells of the markdown line of `log` in the table under `heading`.
+    fn cells<'a>(md: &'a str, heading: &str, log: &str) -> Vec<&'a str> {
+        let start = md.find(heading).unwrap();
+        md[start..]
+            .lines()
+            .find(|l| l.starts_with(&format!("| {log} ")))
+            .unwrap()
+            .split('|')
+            .map(str::trim)
+            .collect()
+    }
+
+    /// Four points in two 5 cm cells, two hits each: two cells and one bit. A point just below
+    /// zero falls in a cell of its own.
+    #[test]
+    fn score_counts_cells_and_entropy() {
+        let s = score(&[(0.01, 0.01), (0.02, 0.04), (0.06, 0.01), (0.09, 0.02)]);
+        assert_eq!(s.cells, 2);
+        assert!((s.entropy_bits - 1.0).abs() < 1e-12, "{}", s.entropy_bits);
+        let s = score(&[(0.01, 0.01), (-0.01, 0.01)]);
+        assert_eq!(s.cells, 2);
+        assert_eq!(score(&[]).cells, 0);
+    }
+
+    /// An even-count log won by the half-open fan and an odd-count log won by the closed fan
+    /// (with the entropy disagreeing): the rows, the sweep, the verdict and the JSON.
+    #[test]
+    fn report_from_known_scores() {
+        let results = [
+            LogResult {
+                sweep: ((0, -2), 99, 100),
+                log: "even".into(),
+                beams: 180,
+                scans: 10,
+                hits: 1000,
+                scores: scores([120, 100, 110, 300], [7.0, 6.5, 6.8, 8.0]),
+                reader: Score {
+                    cells: 100,
+                    entropy_bits: 6.5,
+                },
+            },
+            LogResult {
+                sweep: ((1, 0), 195, 200),
+                log: "odd".into(),
+                beams: 181,
+                scans: 20,
+                hits: 3000,
+                scores: scores([200, 220, 210, 500], [7.2, 7.0, 7.1, 9.0]),
+                reader: Score {
+                    cells: 201,
+                    entropy_bits: 7.25,
+                },
+            },
+        ];
+        let pictures = [("intel".to_owned(), "intel-half-open.png".to_owned())];
+        let report = report(&results, &pictures, 4).unwrap();
+        let md = &report.markdown;
+
+        let even = cells(md, "### Occupied", "even");
+        assert_eq!(
+            &even[1..13],
+            [
+                "even",
+                "180",
+                "10",
+                "1000",
+                "120",
+                "100",
+                "110",
+                "300",
+                "100",
+                "half-open π/n",
+                "10.00%",
+                "half-open π/n"
+            ]
+        );
+        let odd = cells(md, "### Occupied", "odd");
+        assert_eq!(odd[9], "201", "reader cells");
+        assert_eq!(odd[10], "closed π/(n−1)");
+        assert_eq!(odd[11], "5.00%");
+        assert_eq!(odd[12], "half-open π/n", "the entropy's winner");
+
+        let bits = cells(md, "### Entropy", "odd");
+        assert_eq!(
+            &bits[2..7],
+            ["7.2000", "7.0000", "7.1000", "9.0000", "7.2500"]
+        );
+
+        let sweep = cells(md, "### Sweep", "even");
+        assert_eq!(&sweep[3..8], ["1°", "nominal", "-1°", "99", "100"]);
+        let sweep = cells(md, "### Sweep", "odd");
+        assert_eq!(&sweep[4..6], ["+0.5°", "nominal"]);
+
+        assert!(md.starts_with("Which beam angles do `FLASER` scans use?"));
+        assert!(md.contains("Every 4th scan of each corrected log"), "{md}");
+        assert!(md.contains("counted in a 5 cm grid"), "{md}");
+        assert!(
+            md.contains("`half-open π/n` wins 1 of 1 logs. Odd beam counts (181, 361): `closed π/(n−1)` wins 1 of 1 logs."),
+            "{md}"
+        );
+        assert!(md.contains("same winner in 1 of 2 logs"), "{md}");
+        assert!(md.contains("at least 2.50× the cells"), "{md}");
+        assert!(
+            md.contains("crisp as the best candidate in 1 of 2 logs"),
+            "{md}"
+        );
+        assert!(md.contains(
+            "**intel**: `intel-half-open.png`\n\n![intel](carmen-angles/intel-half-open.png)\n"
+        ));
+
+        let json = &report.json;
+        assert_eq!(json["scan_stride"], 4);
+        assert_eq!(json["cell_m"], 0.05);
+        assert_eq!(json["winner_even_beams"], "half-open π/n");
+        assert_eq!(json["winner_odd_beams"], "closed π/(n−1)");
+        let odd = &json["logs"][1];
+        assert_eq!(odd["log"], "odd");
+        assert_eq!(odd["winner_cells"], "closed π/(n−1)");
+        assert_eq!(odd["winner_entropy"], "half-open π/n");
+        assert!((odd["runner_up_margin_percent"].as_f64().unwrap() - 5.0).abs() < 1e-9);
+        assert_eq!(odd["candidates"][3]["fan"], "closed");
+        assert_eq!(odd["candidates"][3]["mirrored"], true);
+        assert_eq!(odd["candidates"][3]["cells"], 500);
+        assert_eq!(odd["reader"]["cells"], 201);
+        assert_eq!(odd["sweep"]["best_first_half_steps"], 1);
+        assert_eq!(odd["sweep"]["best_last_half_steps"], 0);
+        assert_eq!(odd["sweep"]["nominal_cells"], 200);
+    }
+
+    /// Every scan: the page says so and has no picture section without pictures.
+    #[test]
+    fn report_without_stride_or_pictures() {
+        let results = [LogResult {
+            sweep: ((0, 0), 10, 10),
+            log: "one".into(),
+            beams: 361,
+            scans: 1,
+            hits: 361,
+            scores: scores([10, 11, 12, 40], [3.0, 3.1, 3.2, 5.0]),
+            reader: Score {
+                cells: 10,
+                entropy_bits: 3.0,
+            },
+        }];
+        let md = report(&results, &[], 1).unwrap().markdown;
+        assert!(md.contains("Every scan of each corrected log"), "{md}");
+        assert!(!md.contains("### Pictures"), "{md}");
+        assert_eq!(cells(&md, "### Sweep", "one")[3], "0.5°");
+        assert!(md.contains("Odd beam counts (181, 361): `closed π/(n−1)` wins 1 of 1 logs"));
+    }
+}

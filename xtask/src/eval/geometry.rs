@@ -313,6 +313,39 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         );
     }
 
+    let conditions = Conditions {
+        repetitions,
+        min_repetition_secs,
+        quick: ctx.quick,
+        load_before,
+        load_after,
+        cores: std::thread::available_parallelism().map_or(1, usize::from),
+    };
+    report(&cases, &conditions)
+}
+
+/// How the cases were timed, for the page.
+struct Conditions {
+    repetitions: usize,
+    min_repetition_secs: f64,
+    quick: bool,
+    /// 1-minute load average before and after the timing.
+    load_before: Option<f64>,
+    load_after: Option<f64>,
+    /// Cores available to the process.
+    cores: usize,
+}
+
+/// The page and the JSON of the timed `cases`.
+fn report(cases: &[Case], conditions: &Conditions) -> Result<EvalReport> {
+    let &Conditions {
+        repetitions,
+        min_repetition_secs,
+        quick,
+        load_before,
+        load_after,
+        cores,
+    } = conditions;
     let mut table = Table::new([
         "case",
         "grid",
@@ -325,7 +358,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         "speed-up",
         "aim ≥ 1e8 cells/s (3-D)",
     ]);
-    for case in &cases {
+    for case in cases {
         let aim = if case.name.starts_with("3d") {
             if case.fast.wall_cells_per_sec >= AIM_3D_CELLS_PER_SEC {
                 "met"
@@ -368,7 +401,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          the machine; wall-clock rates drop when they do).\n\n\
          Reproduce with Criterion on the identical workloads (same generator and seeds): \
          `cargo bench -p raypath-geometry --bench traversal`.\n",
-        quick = if ctx.quick {
+        quick = if quick {
             ", --quick: 10 000 rays per case"
         } else {
             ", 100 000 rays per case"
@@ -376,7 +409,6 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         table = table.to_markdown()?,
         before = fmt_load(load_before),
         after = fmt_load(load_after),
-        cores = std::thread::available_parallelism().map_or(1, usize::from),
     );
 
     let json_cases: Vec<_> = cases
@@ -411,4 +443,126 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         }),
         headline: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn timing(cells: usize, wall: f64, cpu: f64) -> Timing {
+        Timing {
+            cells,
+            length_m: 1234.5,
+            wall_cells_per_sec: wall,
+            cpu_cells_per_sec: cpu,
+            wall_secs: vec![0.01, 0.02],
+        }
+    }
+
+    fn case(name: &'static str, cells: usize, fast: (f64, f64), naive_wall: f64) -> Case {
+        Case {
+            name,
+            grid: "200³ × 0.1 m",
+            rays: 1000,
+            fast: timing(cells, fast.0, fast.1),
+            naive: timing(cells + 10, naive_wall, naive_wall),
+        }
+    }
+
+    fn row<'a>(md: &'a str, case: &str) -> Vec<&'a str> {
+        md.lines()
+            .find(|l| l.starts_with(&format!("| {case} ")))
+            .unwrap()
+            .split('|')
+            .map(str::trim)
+            .collect()
+    }
+
+    /// Rates, speed-ups, the 3-D aim met by wall clock, by CPU time only or missed, the
+    /// run's conditions and the JSON.
+    #[test]
+    fn report_from_known_timings() {
+        let cases = [
+            case("3d/inside", 12_500, (2.5e8, 3e8), 5e7),
+            case("3d/outside", 8_000, (5e7, 1.2e8), 2e7),
+            case("3d/slow", 4_000, (5e7, 9e7), 5e7),
+            case("2d/inside", 3_000, (9e7, 9.5e7), 3e7),
+        ];
+        let conditions = Conditions {
+            repetitions: 7,
+            min_repetition_secs: 0.25,
+            quick: false,
+            load_before: Some(0.5),
+            load_after: None,
+            cores: 2,
+        };
+        let report = report(&cases, &conditions).unwrap();
+        let md = &report.markdown;
+        assert_eq!(
+            &row(md, "3d/inside")[1..11],
+            [
+                "3d/inside",
+                "200³ × 0.1 m",
+                "1000",
+                "12500",
+                "12.5",
+                "2.500e8",
+                "3.000e8",
+                "5.000e7",
+                "5.0×",
+                "met"
+            ]
+        );
+        assert_eq!(row(md, "3d/outside")[9], "2.5×");
+        assert_eq!(row(md, "3d/outside")[10], "met in CPU time");
+        assert_eq!(row(md, "3d/slow")[9], "1.0×");
+        assert_eq!(row(md, "3d/slow")[10], "missed");
+        assert_eq!(row(md, "2d/inside")[5], "3.0");
+        assert_eq!(row(md, "2d/inside")[10], "—");
+        assert!(
+            md.contains(
+                "Median of 7 repetitions, 100 000 rays per case (each repeats the batch for at \
+                 least 0.25 s)"
+            ),
+            "{md}"
+        );
+        assert!(
+            md.contains("Load average (1 min) before/after: 0.50/unknown on 2 cores"),
+            "{md}"
+        );
+        assert!(md.ends_with("`cargo bench -p raypath-geometry --bench traversal`.\n"));
+
+        let json = &report.json;
+        assert_eq!(json["repetitions"], 7);
+        assert_eq!(json["aim_3d_cells_per_sec"], 1e8);
+        assert_eq!(json["load_average_before"], 0.5);
+        assert!(json["load_average_after"].is_null());
+        let first = &json["cases"][0];
+        assert_eq!(first["case"], "3d/inside");
+        assert_eq!(first["cells"], 12_500);
+        assert_eq!(first["naive_cells"], 12_510);
+        assert_eq!(first["traced_length_m"], 1234.5);
+        assert_eq!(first["median_cells_per_sec_cpu"], 3e8);
+        assert_eq!(first["naive_median_cells_per_sec_wall"], 5e7);
+        assert_eq!(first["wall_secs_per_pass"][1], 0.02);
+        assert_eq!(json["cases"].as_array().unwrap().len(), 4);
+    }
+
+    #[test]
+    fn quick_report_names_its_ray_count() {
+        let conditions = Conditions {
+            repetitions: 5,
+            min_repetition_secs: 0.05,
+            quick: true,
+            load_before: None,
+            load_after: Some(1.234),
+            cores: 8,
+        };
+        let md = report(&[], &conditions).unwrap().markdown;
+        assert!(
+            md.contains("Median of 5 repetitions, --quick: 10 000 rays per case (each repeats the batch for at least 0.05 s)"),
+            "{md}"
+        );
+        assert!(md.contains("before/after: unknown/1.23 on 8 cores"), "{md}");
+    }
 }

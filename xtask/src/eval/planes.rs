@@ -221,3 +221,172 @@ pub fn mean(scans: &[HooverScore], f: impl Fn(&HooverScore) -> f64) -> f64 {
         scans.iter().map(f).sum::<f64>() / scans.len() as f64
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use raypath_planes::{Plane, PlaneFit};
+
+    use super::*;
+
+    /// A plane of `n` rays with a per-ray RMSE of `rmse_m`, at 1/‖w‖ m along `w`'s direction.
+    fn plane(w: [f64; 3], n: usize, rmse_m: f64) -> Plane {
+        Plane {
+            index: Vec::new(),
+            fit: PlaneFit {
+                w: Vector3::from(w),
+                sse: n as f64 * rmse_m * rmse_m,
+                n,
+            },
+        }
+    }
+
+    /// Ground truth and machine labels built group by group: `(gt, machine, rays)`.
+    fn labels(
+        groups: &[(Option<u32>, Option<u32>, usize)],
+    ) -> (Vec<Option<u32>>, Vec<Option<u32>>) {
+        let mut gt = Vec::new();
+        let mut ms = Vec::new();
+        for &(g, m, rays) in groups {
+            gt.extend(std::iter::repeat_n(g, rays));
+            ms.extend(std::iter::repeat_n(m, rays));
+        }
+        (gt, ms)
+    }
+
+    /// Six ground-truth planes (40 rays) against six machine planes, counted by hand at
+    /// T = 0.8:
+    /// * GT 10 (10 rays) ← machine 0 (9 of them, nothing else): correct;
+    /// * GT 11 (10 rays) split into machines 1 and 2 (5 rays each): over-segmented;
+    /// * GT 12 and GT 13 (5 rays each) both in machine 3 (10 rays): one under-segmentation;
+    /// * GT 14 (4 rays) unsegmented: missed;
+    /// * machine 4 (4 rays) on unlabelled rays and label 1 (below 10, not a plane): noise;
+    /// * GT 15 (6 rays) ← machine 5 (the same 6 rays): correct.
+    ///
+    /// f = 2/6, k = (10 + 6)/40; every plane fits to 10 mm except the noise plane (11 m,
+    /// left out of the RMSE); α over the one pair of correct detections: normals 90° apart
+    /// against a ground-truth 100° (folded: 80°) gives 10°.
+    #[test]
+    fn hoover_score_counts_a_known_segmentation() {
+        let (gt, ms) = labels(&[
+            (Some(10), Some(0), 9),
+            (Some(10), None, 1),
+            (Some(11), Some(1), 5),
+            (Some(11), Some(2), 5),
+            (Some(12), Some(3), 5),
+            (Some(13), Some(3), 5),
+            (Some(14), None, 4),
+            (None, Some(4), 2),
+            (Some(1), Some(4), 2),
+            (Some(15), Some(5), 6),
+        ]);
+        let seg = Segmentation {
+            width: gt.len(),
+            height: 1,
+            labels: ms,
+            planes: vec![
+                plane([0.5, 0.0, 0.0], 9, 0.01),
+                plane([0.0, 0.0, 1.0], 5, 0.01),
+                plane([0.0, 0.0, 1.0], 5, 0.01),
+                plane([0.0, 0.0, 1.0], 10, 0.01),
+                plane([0.0, 0.0, 1.0], 4, 11.0),
+                plane([0.0, 0.25, 0.0], 6, 0.01),
+            ],
+            steps: 0,
+        };
+        let angles = [(10, 11, 90.0), (10, 15, 100.0), (12, 13, 45.0)];
+        let s = hoover_score(&gt, &seg, 0.125, Some(&angles)).unwrap();
+        assert!((s.f - 100.0 / 3.0).abs() < 1e-9, "f {}", s.f);
+        assert!((s.k - 40.0).abs() < 1e-9, "k {}", s.k);
+        assert_eq!(
+            (s.n_o, s.n_u, s.n_m, s.n_s),
+            (1.0, 1.0, 1.0, 1.0),
+            "over, under, missed, noise"
+        );
+        assert_eq!((s.gt, s.planes, s.secs), (6.0, 6.0, 0.125));
+        assert!((s.rmse_mm - 10.0).abs() < 1e-9, "rmse {}", s.rmse_mm);
+        assert!((s.alpha_deg - 10.0).abs() < 1e-9, "alpha {}", s.alpha_deg);
+
+        // Without angles, or without a pair of correct detections, α is not defined.
+        assert!(
+            hoover_score(&gt, &seg, 0.0, None)
+                .unwrap()
+                .alpha_deg
+                .is_nan()
+        );
+        let only_misses = [(11, 12, 90.0)];
+        let s = hoover_score(&gt, &seg, 0.0, Some(&only_misses)).unwrap();
+        assert!(s.alpha_deg.is_nan());
+        assert!(hoover_score(&gt[1..], &seg, 0.0, None).is_err());
+    }
+
+    /// A perfect segmentation scores 100 % on both counts; a plane-free one has no RMSE.
+    #[test]
+    fn hoover_score_of_perfect_and_empty_segmentations() {
+        let (gt, ms) = labels(&[(Some(20), Some(0), 8), (Some(21), Some(1), 8)]);
+        let perfect = Segmentation {
+            width: 16,
+            height: 1,
+            labels: ms,
+            planes: vec![
+                plane([1.0, 0.0, 0.0], 8, 0.0),
+                plane([0.0, 1.0, 0.0], 8, 0.0),
+            ],
+            steps: 0,
+        };
+        let s = hoover_score(&gt, &perfect, 1.0, None).unwrap();
+        assert_eq!((s.f, s.k, s.rmse_mm), (100.0, 100.0, 0.0));
+        assert_eq!((s.n_o, s.n_u, s.n_m, s.n_s), (0.0, 0.0, 0.0, 0.0));
+        let empty = Segmentation {
+            labels: vec![None; 16],
+            planes: Vec::new(),
+            ..perfect
+        };
+        let s = hoover_score(&gt, &empty, 1.0, None).unwrap();
+        assert_eq!((s.f, s.k, s.n_m, s.planes), (0.0, 0.0, 2.0, 0.0));
+        assert!(s.rmse_mm.is_nan());
+    }
+
+    #[test]
+    fn mean_over_scans() {
+        let scans = [
+            HooverScore {
+                f: 50.0,
+                ..HooverScore::default()
+            },
+            HooverScore {
+                f: 100.0,
+                ..HooverScore::default()
+            },
+        ];
+        assert_eq!(mean(&scans, |s| s.f), 75.0);
+        assert!(mean(&[], |s| s.f).is_nan());
+    }
+
+    /// The grids' sizes and the parameter labels their tables show.
+    #[test]
+    fn grids_and_their_labels() {
+        let ppe = ppe_grid(&[0.1, 0.2], &[0.5], &[30, 60], 2);
+        assert_eq!(ppe.len(), 4);
+        assert_eq!(ppe[1].1, "√e 0.10, d 0.5, min 60");
+        let Method::Ppe(p) = ppe[3].0 else {
+            panic!("not PPE")
+        };
+        assert!((p.max_increment_m2 - 0.04).abs() < 1e-12);
+        assert_eq!((p.l_max_m, p.min_points, p.refine_rounds), (0.5, 60, 2));
+        assert_eq!(ppe[0].0.name(), "PPE");
+
+        let peac = peac_grid(&[4, 8], &[0.02], &[0.05, 0.1], &[40]);
+        assert_eq!(peac.len(), 4);
+        assert_eq!(peac[3].1, "block 8, tol 0.02, disc 0.10, min 40");
+        let Method::Peac(p) = peac[0].0 else {
+            panic!("not PEAC")
+        };
+        assert!((p.merge_tol_m - 0.03).abs() < 1e-12);
+        assert_eq!(peac[0].0.name(), "PEAC-style");
+
+        let msac = msac_grid(&[0.05], &[0.1, 0.2], &[50]);
+        assert_eq!(msac.len(), 2);
+        assert_eq!(msac[1].1, "dist 0.05, remaining 0.20, min 50");
+        assert_eq!(msac[0].0.name(), "MSAC");
+    }
+}

@@ -75,6 +75,53 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         });
     }
 
+    // Whether raypath-io reads all of each set.
+    let bar = ctx.progress(sets.len() as u64, "reading sets");
+    let mut readability = Vec::new();
+    for set in &sets {
+        readability.push(check_readable(set)?);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let real = RealFigures::read(&sets, ctx);
+    let mut realism_md = String::new();
+    let realism = realism::run(ctx, &mut realism_md)?;
+    let figures = ctx.figure_dir("sim")?;
+    let mut pictures_of_sets = Vec::new();
+    for set in &sets {
+        pictures_of_sets.extend(pictures(set, &figures)?);
+    }
+    report(&Measured {
+        sets,
+        skipped,
+        readability,
+        real,
+        realism_md,
+        realism,
+        pictures: pictures_of_sets,
+    })
+}
+
+/// What `run` found: the sets, their checks, the real figures beside them, the realism
+/// section and the pictures written.
+struct Measured {
+    sets: Vec<SetOnDisk>,
+    /// Sets not generated, with the reason.
+    skipped: Vec<String>,
+    /// Per set, as [`check_readable`] returns it.
+    readability: Vec<(usize, usize, Vec<String>)>,
+    real: RealFigures,
+    /// The realism section's markdown.
+    realism_md: String,
+    /// The realism section's JSON.
+    realism: Value,
+    /// `(caption, file name)` of the pictures in the figure directory.
+    pictures: Vec<(String, String)>,
+}
+
+/// The page and the JSON of what `run` found.
+fn report(m: &Measured) -> Result<EvalReport> {
+    let sets = &m.sets;
     let mut md = String::from(
         "Simulated data sets written by `raypath-sim` (`cargo xtask datasets generate`) in the \
          real formats, read back here through `raypath-io` exactly like real data. **Every row \
@@ -83,7 +130,6 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     );
 
     // What each set holds and whether raypath-io reads all of it.
-    let bar = ctx.progress(sets.len() as u64, "reading sets");
     let mut table = Table::new([
         "set",
         "stands in for",
@@ -93,8 +139,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         "raypath info",
     ]);
     let mut readability = Vec::new();
-    for set in &sets {
-        let (readable, total, failures) = check_readable(set)?;
+    for (set, (readable, total, failures)) in sets.iter().zip(&m.readability) {
         readability.push(serde_json::json!({"set": set.name, "readable": readable, "data_files": total, "failures": failures}));
         table.row([
             format!("`{}`", set.name),
@@ -109,9 +154,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             .to_owned(),
             format!("{readable}/{total} files"),
         ]);
-        bar.inc(1);
     }
-    bar.finish_and_clear();
     md.push_str("## The sets\n\n");
     md.push_str(&table.to_markdown()?);
     md.push_str(
@@ -122,22 +165,19 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          every set carries `SHA256SUMS`; `cargo xtask datasets generate --quick` twice gives \
          identical sums (tested in `crates/sim/tests`).\n",
     );
-    if !skipped.is_empty() {
-        md.push_str(&format!("\nSkipped: {}.\n", skipped.join(", ")));
+    if !m.skipped.is_empty() {
+        md.push_str(&format!("\nSkipped: {}.\n", m.skipped.join(", ")));
     }
 
     md.push_str("\n## Statistics beside the real data and the thesis\n\n");
-    md.push_str(&comparison_table(&sets, ctx)?.to_markdown()?);
+    md.push_str(&comparison_table(sets, &m.real)?.to_markdown()?);
 
     md.push_str("\n## Realism: real KITTI frames beside simulated frames at the same places\n\n");
-    let realism = realism::run(ctx, &mut md)?;
+    md.push_str(&m.realism_md);
 
     md.push_str("\n## Pictures\n\n");
-    let figures = ctx.figure_dir("sim")?;
-    for set in &sets {
-        for (caption, file) in pictures(set, &figures)? {
-            md.push_str(&format!("**{caption}**\n\n![{caption}](sim/{file})\n\n"));
-        }
+    for (caption, file) in &m.pictures {
+        md.push_str(&format!("**{caption}**\n\n![{caption}](sim/{file})\n\n"));
     }
 
     let json = serde_json::json!({
@@ -146,8 +186,8 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             "bytes": s.info["bytes"], "stats": s.info["stats"],
         })).collect::<Vec<_>>(),
         "readability": readability,
-        "skipped": skipped,
-        "realism": realism,
+        "skipped": m.skipped,
+        "realism": m.realism,
     });
     Ok(EvalReport {
         name: "sim",
@@ -191,8 +231,34 @@ fn check_readable(set: &SetOnDisk) -> Result<(usize, usize, Vec<String>)> {
 const SYNPEB_CROP_COMPARABLE: &str = "no — crops of our simulated rooms vs the one crop of the \
      published SynPEB sample: other scenes";
 
+/// The real figures set beside the simulated ones, each read only when its set is present.
+struct RealFigures {
+    /// Scans, beams and mean hit range of the real Intel log (beside `indoor`).
+    intel: Option<(usize, usize, f64)>,
+    /// The real SynPEB sample (beside `synpeb`).
+    synpeb: Option<RealSynpeb>,
+}
+
+impl RealFigures {
+    fn read(sets: &[SetOnDisk], ctx: &EvalContext) -> Self {
+        let present = |name: &str| sets.iter().any(|s| s.name == name);
+        Self {
+            intel: if present("indoor") {
+                real_log_stats(&ctx.data("carmen/corrected/intel-corrected.log.gz"))
+            } else {
+                None
+            },
+            synpeb: if present("synpeb") {
+                real_synpeb(ctx)
+            } else {
+                None
+            },
+        }
+    }
+}
+
 /// Real-sample figures: the SynPEB sample and the corrected CARMEN logs.
-fn comparison_table(sets: &[SetOnDisk], ctx: &EvalContext) -> Result<Table> {
+fn comparison_table(sets: &[SetOnDisk], real_figures: &RealFigures) -> Result<Table> {
     let mut table = Table::new([
         "set",
         "quantity",
@@ -221,7 +287,7 @@ fn comparison_table(sets: &[SetOnDisk], ctx: &EvalContext) -> Result<Table> {
         ]);
     }
     if let Some(s) = find("indoor") {
-        let intel = real_log_stats(&ctx.data("carmen/corrected/intel-corrected.log.gz"));
+        let intel = &real_figures.intel;
         for world in ["office", "lab", "hall"] {
             if s.stat(world).is_none() {
                 continue;
@@ -281,7 +347,7 @@ fn comparison_table(sets: &[SetOnDisk], ctx: &EvalContext) -> Result<Table> {
         ]);
     }
     if let Some(s) = find("synpeb") {
-        let real = real_synpeb(ctx);
+        let real = &real_figures.synpeb;
         table.row([
             "synpeb",
             "planes per scan (≥ 10 pixels)",
@@ -664,4 +730,210 @@ fn kitti_range_image(set: &SetOnDisk, path: &Path) -> Result<bool> {
     png.save(path)
         .with_context(|| format!("writing {}", path.display()))?;
     Ok(true)
+}
+
+#[cfg(test)]
+mod tests {
+    use serde_json::json;
+
+    use super::*;
+
+    fn set(name: &'static str, about: &'static str, info: Value) -> SetOnDisk {
+        SetOnDisk {
+            name,
+            about,
+            dir: PathBuf::from(format!("/sim/{name}")),
+            info,
+        }
+    }
+
+    fn sets() -> Vec<SetOnDisk> {
+        vec![
+            set(
+                "polygons",
+                "thesis ch. 10 scans",
+                json!({
+                    "files": [{"path": "polygons.log"}, {"path": "polygons.json"}],
+                    "bytes": 1_500_000, "quick": true,
+                    "stats": {"scans": 260, "rays_per_scan": 360, "range_noise_std_m": 0.03},
+                }),
+            ),
+            set(
+                "indoor",
+                "CARMEN logs",
+                json!({
+                    "files": [{"path": "office-corrected.log.gz"}],
+                    "bytes": 250_000, "quick": false,
+                    "stats": {"office": {
+                        "scans": 50, "beams_per_scan": 180, "range_m": {"mean": 3.456},
+                        "odometry_drift": {"per_metre": 0.0123},
+                    }},
+                }),
+            ),
+            set(
+                "synpeb",
+                "SynPEB",
+                json!({
+                    "files": [], "bytes": 0,
+                    "stats": {
+                        "full_scans": {"planes_per_scan_min_10_pixels": {"mean": 40.04}},
+                        "crop_100x100_at_row_col_100": {
+                            "planes_per_scan": {"mean": 6.5},
+                            "range_m": {"median_of_scan_medians": 3.25},
+                            "plane_pixel_fraction": {"mean": 0.5},
+                        },
+                    },
+                }),
+            ),
+        ]
+    }
+
+    fn measured(real: RealFigures) -> Measured {
+        Measured {
+            sets: sets(),
+            skipped: vec!["`semi-kitti` (needs `kitti-poles/07` in RAYPATH_DATA)".into()],
+            readability: vec![
+                (1, 1, Vec::new()),
+                (0, 1, vec!["bad gzip".into()]),
+                (0, 0, Vec::new()),
+            ],
+            real,
+            realism_md: "REALISM SECTION\n".into(),
+            realism: json!({"skipped": "no real KITTI frames"}),
+            pictures: vec![("polygons: a caption".into(), "polygons.png".into())],
+        }
+    }
+
+    /// The cells of the line that starts with `| set ` and has `quantity` in its second column.
+    fn row<'a>(md: &'a str, set: &str, quantity: &str) -> Vec<&'a str> {
+        md.lines()
+            .filter(|l| l.starts_with(&format!("| {set} ")))
+            .map(|l| l.split('|').map(str::trim).collect::<Vec<_>>())
+            .find(|cells| cells[2] == quantity)
+            .unwrap_or_else(|| panic!("no row {set} / {quantity} in {md}"))
+    }
+
+    /// Known sets, checks and real figures: the sets table, the comparison rows, the
+    /// sections in order and the JSON.
+    #[test]
+    fn report_from_known_sets() {
+        let real = RealFigures {
+            intel: Some((100, 180, 4.5678)),
+            synpeb: Some(RealSynpeb {
+                planes: 7,
+                median_range_m: 3.2,
+                plane_fraction: 0.456,
+            }),
+        };
+        let report = report(&measured(real)).unwrap();
+        let md = &report.markdown;
+        assert!(md.starts_with("Simulated data sets written by `raypath-sim`"));
+
+        let polygons = md.lines().find(|l| l.starts_with("| `polygons`")).unwrap();
+        let cells: Vec<&str> = polygons.split('|').map(str::trim).collect();
+        assert_eq!(
+            &cells[1..7],
+            [
+                "`polygons`",
+                "thesis ch. 10 scans",
+                "2",
+                "1.5",
+                "quick",
+                "1/1 files"
+            ]
+        );
+        let indoor = md.lines().find(|l| l.starts_with("| `indoor`")).unwrap();
+        assert!(
+            indoor.contains("| full ") && indoor.contains("| 0/1 files"),
+            "{indoor}"
+        );
+        assert!(md.contains("\nSkipped: `semi-kitti` (needs `kitti-poles/07` in RAYPATH_DATA).\n"));
+
+        assert_eq!(row(md, "polygons", "scans × rays")[3], "260 × 360");
+        assert_eq!(row(md, "polygons", "radial noise σ (m)")[3], "0.0300");
+        let office = row(md, "indoor", "office: scans, beams, mean range (m)");
+        assert_eq!(
+            &office[3..6],
+            [
+                "50 × 180, 3.46",
+                "100 × 180, 4.57",
+                "real: intel-corrected.log.gz"
+            ]
+        );
+        assert!(
+            office[6].starts_with("no — simulated office world"),
+            "{}",
+            office[6]
+        );
+        assert_eq!(
+            row(md, "indoor", "office: odometry drift per metre")[3],
+            "0.0123"
+        );
+        assert_eq!(
+            row(md, "synpeb", "planes per scan (≥ 10 pixels)")[3],
+            "40.0"
+        );
+        let crop = row(
+            md,
+            "synpeb",
+            "planes in the 100 × 100 crop of the sample's window",
+        );
+        assert_eq!(&crop[3..5], ["6.5", "7"]);
+        assert_eq!(crop[6], SYNPEB_CROP_COMPARABLE);
+        assert_eq!(
+            &row(md, "synpeb", "median range of the crop (m)")[3..5],
+            ["3.25", "3.20"]
+        );
+        assert_eq!(
+            &row(md, "synpeb", "plane-pixel fraction (crop)")[3..5],
+            ["0.500", "0.456"]
+        );
+        assert!(
+            !md.contains("| corridor "),
+            "no corridor set, no corridor rows"
+        );
+
+        assert!(md.contains(
+            "## Realism: real KITTI frames beside simulated frames at the same places\n\nREALISM \
+             SECTION\n\n## Pictures\n\n**polygons: a caption**\n\n![polygons: a caption](sim/polygons.png)\n\n"
+        ), "{md}");
+
+        let json = &report.json;
+        assert_eq!(json["sets"][0]["name"], "polygons");
+        assert_eq!(json["sets"][0]["dir"], "/sim/polygons");
+        assert_eq!(json["sets"][0]["quick"], true);
+        assert_eq!(json["sets"][1]["bytes"], 250_000);
+        assert_eq!(json["sets"][0]["stats"]["rays_per_scan"], 360);
+        assert_eq!(json["readability"][1]["set"], "indoor");
+        assert_eq!(json["readability"][1]["readable"], 0);
+        assert_eq!(json["readability"][1]["data_files"], 1);
+        assert_eq!(json["readability"][1]["failures"][0], "bad gzip");
+        assert_eq!(
+            json["skipped"][0],
+            "`semi-kitti` (needs `kitti-poles/07` in RAYPATH_DATA)"
+        );
+        assert_eq!(json["realism"]["skipped"], "no real KITTI frames");
+    }
+
+    /// Without the real samples the right column shows a dash.
+    #[test]
+    fn report_without_real_samples() {
+        let real = RealFigures {
+            intel: None,
+            synpeb: None,
+        };
+        let md = report(&measured(real)).unwrap().markdown;
+        assert_eq!(
+            row(&md, "indoor", "office: scans, beams, mean range (m)")[4],
+            "—"
+        );
+        let crop = row(
+            &md,
+            "synpeb",
+            "planes in the 100 × 100 crop of the sample's window",
+        );
+        assert_eq!(crop[4], "—");
+        assert_eq!(row(&md, "synpeb", "plane-pixel fraction (crop)")[4], "—");
+        assert_eq!(row(&md, "polygons", "scans × rays")[4], "260 × 360");
+    }
 }

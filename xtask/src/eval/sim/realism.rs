@@ -168,34 +168,57 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
     } else {
         (&["00", "01", "04", "07"], 10)
     };
-    let mut header: Vec<String> = [
-        "sequence",
-        "data",
-        "returns / frame",
-        "no-return share",
-        "median range [m]",
-        "90 % range [m]",
-        "pole points / frame",
-        "trunk points / frame",
-    ]
-    .map(String::from)
-    .to_vec();
-    header.extend(CLASSES.iter().map(|c| format!("mean I {}", c.1)));
-    let mut table = Table::new(header);
-    let mut gaps = Table::new([
-        "sequence",
-        "elevation histogram overlap",
-        "range histogram overlap",
-        "intensity histogram overlap",
-        "returns sim / real",
-        "pole points sim / real",
-    ]);
-    let mut rows = Vec::new();
+    let mut section = Section::new();
     for seq in sequences {
         let Some((mut real, mut sim, beams)) = sequence_stats(ctx, seq, frames)? else {
             continue;
         };
-        for (name, s) in [("real", &mut real), ("simulated", &mut sim)] {
+        section.add(seq, &mut real, &mut sim, beams);
+    }
+    section.write(frames, md)
+}
+
+/// The section's tables and JSON rows, filled one sequence at a time.
+struct Section {
+    table: Table,
+    gaps: Table,
+    rows: Vec<Value>,
+}
+
+impl Section {
+    fn new() -> Self {
+        let mut header: Vec<String> = [
+            "sequence",
+            "data",
+            "returns / frame",
+            "no-return share",
+            "median range [m]",
+            "90 % range [m]",
+            "pole points / frame",
+            "trunk points / frame",
+        ]
+        .map(String::from)
+        .to_vec();
+        header.extend(CLASSES.iter().map(|c| format!("mean I {}", c.1)));
+        let gaps = Table::new([
+            "sequence",
+            "elevation histogram overlap",
+            "range histogram overlap",
+            "intensity histogram overlap",
+            "returns sim / real",
+            "pole points sim / real",
+        ]);
+        Self {
+            table: Table::new(header),
+            gaps,
+            rows: Vec::new(),
+        }
+    }
+
+    /// Adds one sequence: the statistics of its real frames and of the simulated frames at
+    /// the same places, `beams` firings per frame.
+    fn add(&mut self, seq: &str, real: &mut Stats, sim: &mut Stats, beams: usize) {
+        for (name, s) in [("real", &mut *real), ("simulated", &mut *sim)] {
             let mut row = vec![
                 seq.to_string(),
                 name.to_owned(),
@@ -207,14 +230,14 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
                 fmt_num(s.per_frame(s.trunk_points), 0),
             ];
             row.extend((0..CLASSES.len()).map(|k| fmt_num(s.class_mean(k), 3)));
-            table.row(row);
+            self.table.row(row);
         }
         let elevation_overlap = overlap(&real.elevation_hist, &sim.elevation_hist);
         let range_overlap = overlap(&real.range_hist, &sim.range_hist);
         let intensity_overlap = overlap(&real.intensity_hist, &sim.intensity_hist);
         let returns_ratio = sim.returns as f64 / real.returns.max(1) as f64;
         let pole_ratio = sim.pole_points as f64 / real.pole_points.max(1) as f64;
-        gaps.row([
+        self.gaps.row([
             seq.to_string(),
             fmt_num(elevation_overlap, 3),
             fmt_num(range_overlap, 3),
@@ -234,43 +257,49 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
                     .collect::<Vec<_>>(),
             })
         };
-        rows.push(json!({
+        self.rows.push(json!({
             "sequence": seq, "beams_per_frame": beams,
-            "real": side(&real), "simulated": side(&sim),
+            "real": side(real), "simulated": side(sim),
             "elevation_overlap": elevation_overlap, "range_overlap": range_overlap,
             "intensity_overlap": intensity_overlap, "returns_ratio": returns_ratio,
             "pole_points_ratio": pole_ratio,
         }));
     }
-    if rows.is_empty() {
+
+    /// Writes the section (frames 0 to `frames` − 1 of each sequence) into `md` and returns
+    /// its JSON; a skip note when no sequence was added.
+    fn write(self, frames: usize, md: &mut String) -> Result<Value> {
+        let Self { table, gaps, rows } = self;
+        if rows.is_empty() {
+            let _ = writeln!(
+                md,
+                "*Skipped: no real KITTI frames with pole maps in RAYPATH_DATA.*\n"
+            );
+            return Ok(json!({ "skipped": "no real KITTI frames" }));
+        }
         let _ = writeln!(
             md,
-            "*Skipped: no real KITTI frames with pole maps in RAYPATH_DATA.*\n"
+            "Each **real** KITTI HDL-64E frame (`kitti/sequences/NN`, frames 0–{}) beside the frame \
+             **simulated** by `raypath-sim` at the same index of the same drive (the semi-synthetic \
+             KITTI world: the real trajectory of `kitti-poles/NN` and its real pole map, seed \
+             {SEED}). The two trajectories differ by up to a metre (SemanticKITTI's poses vs the \
+             KITTI ground truth) and the simulated street has generic buildings, trees and cars, so \
+             only distributions are compared. Elevations in 0.5° bins as seen from the velodyne \
+             origin (the JSON also has counts per nearest nominal ring); no-return share against \
+             64 × {} firings; intensities are KITTI's reflectance in [0, 1] and the \
+             simulator's.\n",
+            frames - 1,
+            beams_hint(&rows),
         );
-        return Ok(json!({ "skipped": "no real KITTI frames" }));
+        md.push_str(&table.to_markdown()?);
+        let _ = writeln!(
+            md,
+            "\nHow far the simulation is from the real frames (1 = identical distributions):\n"
+        );
+        md.push_str(&gaps.to_markdown()?);
+        md.push('\n');
+        Ok(json!({ "sequences": rows }))
     }
-    let _ = writeln!(
-        md,
-        "Each **real** KITTI HDL-64E frame (`kitti/sequences/NN`, frames 0–{}) beside the frame \
-         **simulated** by `raypath-sim` at the same index of the same drive (the semi-synthetic \
-         KITTI world: the real trajectory of `kitti-poles/NN` and its real pole map, seed \
-         {SEED}). The two trajectories differ by up to a metre (SemanticKITTI's poses vs the \
-         KITTI ground truth) and the simulated street has generic buildings, trees and cars, so \
-         only distributions are compared. Elevations in 0.5° bins as seen from the velodyne \
-         origin (the JSON also has counts per nearest nominal ring); no-return share against \
-         64 × {} firings; intensities are KITTI's reflectance in [0, 1] and the \
-         simulator's.\n",
-        frames - 1,
-        beams_hint(&rows),
-    );
-    md.push_str(&table.to_markdown()?);
-    let _ = writeln!(
-        md,
-        "\nHow far the simulation is from the real frames (1 = identical distributions):\n"
-    );
-    md.push_str(&gaps.to_markdown()?);
-    md.push('\n');
-    Ok(json!({ "sequences": rows }))
 }
 
 fn beams_hint(rows: &[Value]) -> u64 {
@@ -293,6 +322,12 @@ pub fn gap_note(ctx: &EvalContext) -> Result<String> {
                 .to_owned(),
         );
     };
+    Ok(gap_text(&mut real, &mut sim, beams, FRAMES))
+}
+
+/// The paragraph of [`gap_note`] from the statistics of real frames 0 to `frames` − 1 and of
+/// the simulated frames at the same places, `beams` firings per frame.
+fn gap_text(real: &mut Stats, sim: &mut Stats, beams: usize, frames: usize) -> String {
     let class = |s: &Stats, name: &str| {
         CLASSES
             .iter()
@@ -300,7 +335,7 @@ pub fn gap_note(ctx: &EvalContext) -> Result<String> {
             .map_or(f64::NAN, |k| s.class_mean(k))
     };
     let no_return = |s: &Stats| 1.0 - s.per_frame(s.returns) / beams as f64;
-    Ok(format!(
+    format!(
         "**Simulated scans, not real ones.** How far `raypath-sim` is from real scans, \
          measured in this run on real KITTI 00 frames 0–{last} beside the same frames \
          simulated (the realism section of `eval sim` has the full comparison): {returns:.2}× \
@@ -310,19 +345,169 @@ pub fn gap_note(ctx: &EvalContext) -> Result<String> {
          the real pole points; histogram overlap (1 = identical) of elevations {elev:.2}, \
          ranges {range:.2}, intensities {int:.2}. Simulated rows show a method on cleaner, \
          shorter-range scans than real ones; they are not real-data results.\n",
-        last = FRAMES - 1,
+        last = frames - 1,
         returns = sim.returns as f64 / real.returns.max(1) as f64,
-        nr_sim = no_return(&sim),
-        nr_real = no_return(&real),
+        nr_sim = no_return(sim),
+        nr_real = no_return(real),
         q_sim = sim.quantile(0.9),
         q_real = real.quantile(0.9),
-        road_sim = class(&sim, "road"),
-        road_real = class(&real, "road"),
-        veg_sim = class(&sim, "vegetation"),
-        veg_real = class(&real, "vegetation"),
+        road_sim = class(sim, "road"),
+        road_real = class(real, "road"),
+        veg_sim = class(sim, "vegetation"),
+        veg_real = class(real, "vegetation"),
         poles = sim.pole_points as f64 / real.pole_points.max(1) as f64,
         elev = overlap(&real.elevation_hist, &sim.elevation_hist),
         range = overlap(&real.range_hist, &sim.range_hist),
         int = overlap(&real.intensity_hist, &sim.intensity_hist),
-    ))
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two frames of 50 real returns each: ranges 1–10 m, two elevation bins, road intensity
+    /// 0.5, 10 pole and 4 trunk points.
+    fn real() -> Stats {
+        let mut s = Stats::new(2);
+        s.frames = 2;
+        s.returns = 100;
+        s.ranges = (1..=10).map(f64::from).collect();
+        s.elevation_hist[0] = 1.0;
+        s.elevation_hist[1] = 1.0;
+        s.range_hist[3] = 10.0;
+        s.intensity_hist[10] = 4.0;
+        s.class_intensity[0] = (1.5, 3);
+        s.pole_points = 10;
+        s.trunk_points = 4;
+        s
+    }
+
+    /// Two frames of 30 simulated returns each: ranges 2–20 m, one elevation bin, no
+    /// intensities in the histogram, road 0.25, vegetation 0.3, 6 pole points.
+    fn simulated() -> Stats {
+        let mut s = Stats::new(2);
+        s.frames = 2;
+        s.returns = 60;
+        s.ranges = (1..=10).map(|i| f64::from(2 * i)).collect();
+        s.elevation_hist[0] = 1.0;
+        s.range_hist[3] = 5.0;
+        s.class_intensity[0] = (1.0, 4);
+        s.class_intensity[2] = (0.3, 1);
+        s.pole_points = 6;
+        s
+    }
+
+    fn cells(line: &str) -> Vec<&str> {
+        line.split('|').map(str::trim).collect()
+    }
+
+    #[test]
+    fn nearest_and_overlap() {
+        assert_eq!(nearest(&[-1.0, 0.0, 2.0], 0.9), 1);
+        assert_eq!(nearest(&[-1.0, 0.0, 2.0], 1.1), 2);
+        assert_eq!(nearest(&[-1.0, 0.0, 2.0], -5.0), 0);
+        assert_eq!(nearest(&[-1.0, 0.0, 2.0], 5.0), 2);
+        assert_eq!(overlap(&[1.0, 1.0], &[2.0, 0.0]), 0.5);
+        assert!(overlap(&[1.0], &[0.0]).is_nan());
+    }
+
+    /// One sequence of known statistics: the real and the simulated row, the gaps and the
+    /// JSON.
+    #[test]
+    fn section_from_known_statistics() {
+        let mut section = Section::new();
+        section.add("00", &mut real(), &mut simulated(), 256);
+        let mut md = String::from("before\n");
+        let json = section.write(10, &mut md).unwrap();
+
+        assert!(
+            md.starts_with("before\nEach **real** KITTI HDL-64E frame"),
+            "{md}"
+        );
+        assert!(md.contains("frames 0–9) beside the frame"), "{md}");
+        assert!(md.contains("seed 2020)"), "{md}");
+        assert!(md.contains("against 64 × 4 firings"), "{md}");
+        let line = |start: &str| md.lines().find(|l| l.starts_with(start)).unwrap();
+        assert_eq!(
+            &cells(line("| 00       | real "))[1..14],
+            [
+                "00", "real", "50", "0.805", "6.0", "9.0", "5", "2", "0.500", "—", "—", "—", "—"
+            ]
+        );
+        assert_eq!(
+            &cells(line("| 00       | simulated "))[1..14],
+            [
+                "00",
+                "simulated",
+                "30",
+                "0.883",
+                "12.0",
+                "18.0",
+                "3",
+                "0",
+                "0.250",
+                "—",
+                "0.300",
+                "—",
+                "—"
+            ]
+        );
+        assert!(md.contains("\nHow far the simulation is from the real frames"));
+        let gaps = md.split("identical distributions):").nth(1).unwrap();
+        let gap = gaps.lines().find(|l| l.starts_with("| 00 ")).unwrap();
+        assert_eq!(
+            &cells(gap)[1..7],
+            ["00", "0.500", "1.000", "—", "0.60", "0.60"]
+        );
+        assert!(md.ends_with("|\n\n"), "{md:?}");
+
+        let row = &json["sequences"][0];
+        assert_eq!(row["sequence"], "00");
+        assert_eq!(row["beams_per_frame"], 256);
+        assert_eq!(row["elevation_overlap"], 0.5);
+        assert_eq!(row["range_overlap"], 1.0);
+        assert!(row["intensity_overlap"].is_null(), "NaN is written as null");
+        assert_eq!(row["returns_ratio"], 0.6);
+        assert_eq!(row["pole_points_ratio"], 0.6);
+        assert_eq!(row["real"]["returns_per_frame"], 50.0);
+        assert_eq!(row["real"]["trunk_points_per_frame"], 2.0);
+        assert_eq!(row["simulated"]["class_mean_intensity"][0]["name"], "road");
+        assert_eq!(row["simulated"]["class_mean_intensity"][0]["class"], 40);
+        assert_eq!(row["simulated"]["class_mean_intensity"][0]["mean"], 0.25);
+        assert_eq!(row["simulated"]["elevation_histogram_half_degree"][0], 1.0);
+    }
+
+    #[test]
+    fn section_without_sequences_is_skipped() {
+        let mut md = String::new();
+        let json = Section::new().write(3, &mut md).unwrap();
+        assert_eq!(
+            md,
+            "*Skipped: no real KITTI frames with pole maps in RAYPATH_DATA.*\n\n"
+        );
+        assert_eq!(json["skipped"], "no real KITTI frames");
+    }
+
+    /// The one-paragraph note of other reports, from the same known statistics.
+    #[test]
+    fn gap_text_from_known_statistics() {
+        let text = gap_text(&mut real(), &mut simulated(), 256, 3);
+        assert!(
+            text.starts_with("**Simulated scans, not real ones.**"),
+            "{text}"
+        );
+        for fragment in [
+            "real KITTI 00 frames 0–2 beside",
+            "0.60× the real returns per frame",
+            "no-return share 0.88 (real 0.80)",
+            "90 % of ranges within 18 m (real 9 m)",
+            "mean intensity on road 0.25 (real 0.50)",
+            "vegetation 0.30 (real NaN)",
+            "0.6× the real pole points",
+            "of elevations 0.50, ranges 1.00, intensities NaN.",
+        ] {
+            assert!(text.contains(fragment), "{fragment:?} in {text}");
+        }
+    }
 }
