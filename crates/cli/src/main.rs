@@ -32,6 +32,9 @@ use clap::{CommandFactory, Parser, Subcommand};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Print one JSON document on standard output (a failure as `{"error": …}`).
+    #[arg(long, global = true)]
+    json: bool,
     /// No progress bars, warnings or notes on standard error (errors are still printed).
     #[arg(short, long, global = true, conflicts_with = "verbose")]
     quiet: bool,
@@ -107,7 +110,7 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(error) => return parse_failure(&error),
     };
-    commands::console::set(cli.quiet, cli.verbose);
+    commands::console::set(cli.quiet, cli.verbose, cli.json);
     let result = match &cli.command {
         Command::Info(args) => commands::info::run(args),
         Command::Convert(args) => commands::convert::run(args),

@@ -48,18 +48,14 @@ pub struct Args {
     /// Degree of the range polynomial.
     #[arg(long, default_value_t = 4, value_name = "N")]
     pub degree: usize,
-    /// Print one JSON document on standard output.
-    #[arg(long)]
-    pub json: bool,
 }
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let name = args.samples.display().to_string();
-    let file = std::fs::File::open(&args.samples)
-        .map_err(|e| Failure::input(format!("{name}: {e}"), args.json))?;
-    let samples =
-        read_samples_csv(BufReader::new(file), &name).map_err(|e| Failure::input(e, args.json))?;
+    let file =
+        std::fs::File::open(&args.samples).map_err(|e| Failure::input(format!("{name}: {e}")))?;
+    let samples = read_samples_csv(BufReader::new(file), &name).map_err(Failure::input)?;
     let model = match args.model {
         ModelArg::Lut => {
             let config = LutConfig {
@@ -68,12 +64,12 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             };
             IntensityCorrection::Lut(
                 IntensityLut::fit(&samples, &config)
-                    .map_err(|e| Failure::input(format!("{name}: {e}"), args.json))?,
+                    .map_err(|e| Failure::input(format!("{name}: {e}")))?,
             )
         }
         ModelArg::Range => IntensityCorrection::Range(
             RangePolynomial::fit(&samples, args.degree, 10f64.to_radians())
-                .map_err(|e| Failure::input(format!("{name}: {e}"), args.json))?,
+                .map_err(|e| Failure::input(format!("{name}: {e}")))?,
         ),
         ModelArg::Raw => IntensityCorrection::Raw,
     };
@@ -84,16 +80,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         .filter_map(|s| model.relative(s.intensity, s.range_m, s.incidence_rad))
         .map(|r| (r - 1.0).abs())
         .fold(0.0, f64::max);
-    let text = serde_json::to_string(&model).map_err(|e| Failure {
-        message: e.to_string(),
-        bad_input: false,
-        json: args.json,
-    })?;
-    std::fs::write(&args.out, text).map_err(|e| Failure {
-        message: format!("{}: {e}", args.out.display()),
-        bad_input: false,
-        json: args.json,
-    })?;
+    let text = serde_json::to_string(&model).map_err(|e| Failure::internal(e.to_string()))?;
+    std::fs::write(&args.out, text)
+        .map_err(|e| Failure::internal(format!("{}: {e}", args.out.display())))?;
     let (ranges, angles, inside) = match &model {
         IntensityCorrection::Lut(l) => (
             l.ranges,
@@ -102,7 +91,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         ),
         _ => (0, 0, f64::NAN),
     };
-    if args.json {
+    if super::console::json() {
         println!(
             "{}",
             json!({

@@ -1,20 +1,29 @@
-//! What the program says on standard error besides its errors: progress bars, warnings and
-//! notes, and with `-v` the time each stage took. `--quiet` silences all of it (errors are
+//! The global flags, and what the program says on standard error besides its errors:
+//! progress bars, warnings and notes, and with `-v` the time each stage took. `--quiet` silences all of it (errors are
 //! still printed); progress bars are drawn only when standard error is a terminal, so logs
 //! and pipes stay clean.
 
-use std::sync::atomic::{AtomicU8, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressFinish, ProgressStyle};
 
 /// 0 = `--quiet`, 1 = normal, 2 and more = `-v`.
 static LEVEL: AtomicU8 = AtomicU8::new(1);
+/// The global `--json`.
+static JSON: AtomicBool = AtomicBool::new(false);
 
-/// Sets the verbosity from the global flags (once, in `main`).
-pub fn set(quiet: bool, verbose: u8) {
+/// Sets the global flags (once, in `main`).
+pub fn set(quiet: bool, verbose: u8, json: bool) {
     let level = if quiet { 0 } else { 1 + verbose.min(2) };
     LEVEL.store(level, Ordering::Relaxed);
+    JSON.store(json, Ordering::Relaxed);
+}
+
+/// Whether `--json` was given: every subcommand then prints one JSON document on standard
+/// output, and a failure `{"error": …}`.
+pub fn json() -> bool {
+    JSON.load(Ordering::Relaxed)
 }
 
 fn level() -> u8 {

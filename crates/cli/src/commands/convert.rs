@@ -63,9 +63,6 @@ pub struct Args {
     /// Chunk compression of a written bag.
     #[arg(long, value_enum, default_value_t = Compression::Zstd)]
     pub compression: Compression,
-    /// Print one JSON object (keys: from, to, frames, reference_poses, output).
-    #[arg(long)]
-    pub json: bool,
     #[command(flatten)]
     pub source: SourceArgs,
 }
@@ -85,12 +82,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             ..BagWriteOptions::default()
         },
     };
-    let report =
-        convert(&args.input, &args.output, &options).map_err(|e| Failure::input(e, args.json))?;
-    if args.json {
+    let report = convert(&args.input, &args.output, &options).map_err(Failure::input)?;
+    if super::console::json() {
         println!(
             "{}",
-            serde_json::to_string(&report).map_err(|e| Failure::input(e, true))?
+            serde_json::to_string(&report).map_err(Failure::input)?
         );
     } else {
         println!(

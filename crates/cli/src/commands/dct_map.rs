@@ -60,9 +60,6 @@ pub struct Args {
     /// Write the map: `*.json` (coefficients) or `*.png` (p_ref picture).
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
-    /// Print one JSON document on standard output.
-    #[arg(long)]
-    pub json: bool,
     /// How to read the log.
     #[command(flatten)]
     pub source: SourceArgs,
@@ -78,27 +75,23 @@ struct Rays {
     last_stamp_secs: f64,
 }
 
-fn parse_numbers(text: &str, n: usize, what: &str, json: bool) -> Result<Vec<f64>, Failure> {
+fn parse_numbers(text: &str, n: usize, what: &str) -> Result<Vec<f64>, Failure> {
     let values: Vec<f64> = text
         .split(',')
         .map(|s| s.trim().parse::<f64>())
         .collect::<Result<_, _>>()
-        .map_err(|e| Failure::input(format!("{what} {text:?}: {e}"), json))?;
+        .map_err(|e| Failure::input(format!("{what} {text:?}: {e}")))?;
     if values.len() != n || values.iter().any(|v| !v.is_finite()) {
-        return Err(Failure::input(
-            format!("{what} {text:?}: expected {n} finite comma-separated numbers"),
-            json,
-        ));
+        return Err(Failure::input(format!(
+            "{what} {text:?}: expected {n} finite comma-separated numbers"
+        )));
     }
     Ok(values)
 }
 
 /// The rays of every scan with a reference pose, in the world frame.
 fn read_rays(args: &Args) -> Result<Rays, Failure> {
-    let frames = args
-        .source
-        .read_frames(&args.log)
-        .map_err(|e| Failure::input(e, args.json))?;
+    let frames = args.source.read_frames(&args.log).map_err(Failure::input)?;
     let mut rays = Vec::new();
     let mut poses = Vec::new();
     for (frame, pose) in frames.iter().zip(reference_track(&frames)) {
@@ -108,10 +101,10 @@ fn read_rays(args: &Args) -> Result<Rays, Failure> {
         }
     }
     if rays.is_empty() {
-        return Err(Failure::input(
-            format!("{}: no laser scans", args.log.display()),
-            args.json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: no laser scans",
+            args.log.display()
+        )));
     }
     let last_stamp_secs = frames.iter().map(|f| f.stamp_secs).fold(0.0, f64::max);
     Ok(Rays {
@@ -123,26 +116,23 @@ fn read_rays(args: &Args) -> Result<Rays, Failure> {
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let json = args.json;
-    let lm = parse_numbers(&args.coefficients, 2, "--coefficients", json)?;
+    let json = super::console::json();
+    let lm = parse_numbers(&args.coefficients, 2, "--coefficients")?;
     if lm
         .iter()
         .any(|v| v.fract() != 0.0 || *v < 1.0 || *v > 200.0)
     {
-        return Err(Failure::input(
-            format!(
-                "--coefficients {:?}: L and M must be integers in 1..=200",
-                args.coefficients
-            ),
-            json,
-        ));
+        return Err(Failure::input(format!(
+            "--coefficients {:?}: L and M must be integers in 1..=200",
+            args.coefficients
+        )));
     }
     let shape = Shape {
         l: lm[0] as usize,
         m: lm[1] as usize,
     };
     if args.rays == 0 {
-        return Err(Failure::input("--rays must be positive", json));
+        return Err(Failure::input("--rays must be positive"));
     }
     if let Some(out) = &args.out {
         let ext = out
@@ -150,13 +140,13 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             .map(|e| e.to_string_lossy().to_lowercase())
             .unwrap_or_default();
         if ext != "png" && ext != "json" {
-            return Err(Failure::input(
-                format!("--out {}: use a .json or .png file name", out.display()),
-                json,
-            ));
+            return Err(Failure::input(format!(
+                "--out {}: use a .json or .png file name",
+                out.display()
+            )));
         }
     }
-    let mut recording = Recording::open(&args.record, json)?;
+    let mut recording = Recording::open(&args.record)?;
     let Rays {
         rays,
         poses,
@@ -164,18 +154,18 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     } = read_rays(args)?;
     let patch = if args.patch == "auto" {
         auto_patch(&rays, 10.0).ok_or_else(|| {
-            Failure::input(
-                format!("{}: no rays to choose a patch from", args.log.display()),
-                json,
-            )
+            Failure::input(format!(
+                "{}: no rays to choose a patch from",
+                args.log.display()
+            ))
         })?
     } else {
-        let v = parse_numbers(&args.patch, 4, "--patch", json)?;
+        let v = parse_numbers(&args.patch, 4, "--patch")?;
         if v[2] <= 0.0 || v[3] <= 0.0 {
-            return Err(Failure::input(
-                format!("--patch {:?}: X and Y must be positive", args.patch),
-                json,
-            ));
+            return Err(Failure::input(format!(
+                "--patch {:?}: X and Y must be positive",
+                args.patch
+            )));
         }
         Patch {
             min: [v[0], v[1]],
@@ -191,20 +181,13 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         args.seed,
     );
     if mapping.is_empty() {
-        return Err(Failure::input(
-            format!(
-                "{}: no ray reaches the patch {:?}",
-                args.log.display(),
-                patch
-            ),
-            json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: no ray reaches the patch {:?}",
+            args.log.display(),
+            patch
+        )));
     }
-    let fail = |e: raypath_dct_map::DctError| Failure {
-        message: e.to_string(),
-        bad_input: false,
-        json,
-    };
+    let fail = |e: raypath_dct_map::DctError| Failure::internal(e.to_string());
     let [xe, ye] = patch.extent_m;
     let truth = GroundTruth::new(patch.extent_m, TRUTH_CELL_M, &mapping).map_err(fail)?;
     let (map, grid, c) = compare(
@@ -217,7 +200,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     )
     .map_err(fail)?;
     if let Some(out) = &args.out {
-        write_map(out, &map, json)?;
+        write_map(out, &map)?;
     }
     if let Some(recording) = &mut recording {
         record(recording, last_stamp_secs, &patch, &map, &grid, &poses)?;
@@ -326,16 +309,12 @@ fn record(
     recording.planar_trajectory(topic::TRAJECTORY, stamp, poses)
 }
 
-fn write_map(out: &std::path::Path, map: &DctMap, json: bool) -> Result<(), Failure> {
+fn write_map(out: &std::path::Path, map: &DctMap) -> Result<(), Failure> {
     let ext = out
         .extension()
         .map(|e| e.to_string_lossy().to_lowercase())
         .unwrap_or_default();
-    let io_fail = |e: String| Failure {
-        message: format!("{}: {e}", out.display()),
-        bad_input: false,
-        json,
-    };
+    let io_fail = |e: String| Failure::internal(format!("{}: {e}", out.display()));
     match ext.as_str() {
         "png" => {
             let [xe, ye] = map.extent_m();
@@ -351,9 +330,9 @@ fn write_map(out: &std::path::Path, map: &DctMap, json: bool) -> Result<(), Fail
             let text = serde_json::to_string_pretty(map).map_err(|e| io_fail(e.to_string()))?;
             std::fs::write(out, text).map_err(|e| io_fail(e.to_string()))
         }
-        _ => Err(Failure::input(
-            format!("--out {}: use a .json or .png file name", out.display()),
-            json,
-        )),
+        _ => Err(Failure::input(format!(
+            "--out {}: use a .json or .png file name",
+            out.display()
+        ))),
     }
 }

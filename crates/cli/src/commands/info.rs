@@ -15,10 +15,6 @@ pub struct Args {
     /// time span), or an Ouster .pcap/.pcapng with its metadata .json beside it (frames,
     /// columns × beams, profile, valid returns, range span).
     pub path: PathBuf,
-    /// Print one JSON object (keys: format, scans, beams, points, poses, odometry, width,
-    /// height, labels, bbox, time_span, nodes, and format-specific entries).
-    #[arg(long)]
-    pub json: bool,
     /// Read the input as this format instead of detecting it (for example `carmen`, `pcd`,
     /// `xyz`, `octomap-bt`, `kitti`, `nclt`).
     #[arg(long, value_name = "NAME")]
@@ -30,24 +26,17 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let format = match &args.format {
         Some(name) => Format::from_name(name).ok_or_else(|| {
             let names: Vec<_> = Format::ALL.iter().map(|f| f.name()).collect();
-            Failure::input(
-                format!(
-                    "unknown format {name:?}; choose one of {}",
-                    names.join(", ")
-                ),
-                args.json,
-            )
+            Failure::input(format!(
+                "unknown format {name:?}; choose one of {}",
+                names.join(", ")
+            ))
         })?,
-        None => Format::detect(&args.path).map_err(|e| Failure::input(e, args.json))?,
+        None => Format::detect(&args.path).map_err(Failure::input)?,
     };
-    let summary =
-        raypath_io::summarize_as(&args.path, format).map_err(|e| Failure::input(e, args.json))?;
-    if args.json {
-        let text = serde_json::to_string_pretty(&summary).map_err(|e| Failure {
-            message: e.to_string(),
-            bad_input: false,
-            json: false,
-        })?;
+    let summary = raypath_io::summarize_as(&args.path, format).map_err(Failure::input)?;
+    if super::console::json() {
+        let text =
+            serde_json::to_string_pretty(&summary).map_err(|e| Failure::internal(e.to_string()))?;
         println!("{text}");
     } else {
         print!("{}", render_text(&args.path, &summary));

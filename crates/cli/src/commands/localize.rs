@@ -110,9 +110,6 @@ pub struct Args {
     /// Write the estimates as a TUM trajectory (`t x y z qx qy qz qw`).
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
-    /// Print one JSON document on standard output.
-    #[arg(long)]
-    pub json: bool,
     /// How to read the log and the ground truth.
     #[command(flatten)]
     pub source: SourceArgs,
@@ -123,45 +120,32 @@ pub struct Args {
 
 /// Reads a TUM file `t x y z qx qy qz qw` (through `raypath_io::tum`), keeping x, y and the
 /// yaw.
-fn read_tum(path: &Path, json: bool) -> Result<Vec<(f64, Pose2)>, Failure> {
+fn read_tum(path: &Path) -> Result<Vec<(f64, Pose2)>, Failure> {
     let out: Vec<(f64, Pose2)> = raypath_io::tum::read_tum(path)
-        .map_err(|e| Failure::input(e, json))?
+        .map_err(Failure::input)?
         .into_iter()
         .map(|p| (p.time_s, p.pose.to_planar()))
         .collect();
     if out.is_empty() {
-        return Err(Failure::input(
-            format!(
-                "{}: no poses (neither a CARMEN log with laser scans nor a TUM file)",
-                path.display()
-            ),
-            json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: no poses (neither a CARMEN log with laser scans nor a TUM file)",
+            path.display()
+        )));
     }
     Ok(out)
 }
 
-fn parse_initial(text: &str, json: bool) -> Result<Pose2, Failure> {
+fn parse_initial(text: &str) -> Result<Pose2, Failure> {
     let v: Vec<f64> = text
         .split(',')
         .map(|s| s.trim().parse::<f64>())
         .collect::<Result<_, _>>()
-        .map_err(|_| Failure::input(format!("--initial {text:?}: expected x,y,theta"), json))?;
+        .map_err(|_| Failure::input(format!("--initial {text:?}: expected x,y,theta")))?;
     match v[..] {
         [x, y, theta] if v.iter().all(|c| c.is_finite()) => Ok(Pose2::new(x, y, theta)),
-        _ => Err(Failure::input(
-            format!("--initial {text:?}: expected three finite numbers x,y,theta"),
-            json,
-        )),
-    }
-}
-
-/// A failure that is not the user's input.
-fn internal(error: impl std::fmt::Display, json: bool) -> Failure {
-    Failure {
-        message: error.to_string(),
-        bad_input: false,
-        json,
+        _ => Err(Failure::input(format!(
+            "--initial {text:?}: expected three finite numbers x,y,theta"
+        ))),
     }
 }
 
@@ -172,7 +156,6 @@ fn read_ground_truth(
     path: &Path,
     source: &SourceArgs,
     robot_from_laser: Pose2,
-    json: bool,
 ) -> Result<Vec<(f64, Pose2)>, Failure> {
     let to_robot = |frames: Vec<PlanarFrame>| -> Vec<(f64, Pose2)> {
         let track = reference_track(&frames);
@@ -183,16 +166,9 @@ fn read_ground_truth(
             .collect()
     };
     let planar = if is_bag(path) {
-        let poses = to_robot(
-            source
-                .read_frames(path)
-                .map_err(|e| Failure::input(e, json))?,
-        );
+        let poses = to_robot(source.read_frames(path).map_err(Failure::input)?);
         if poses.is_empty() {
-            return Err(Failure::input(
-                format!("{}: no poses", path.display()),
-                json,
-            ));
+            return Err(Failure::input(format!("{}: no poses", path.display())));
         }
         Some(poses)
     } else {
@@ -205,7 +181,7 @@ fn read_ground_truth(
     };
     let mut poses = match planar {
         Some(poses) => poses,
-        None => read_tum(path, json)?,
+        None => read_tum(path)?,
     };
     poses.sort_by(|a, b| a.0.total_cmp(&b.0));
     poses.dedup_by(|b, a| b.0 <= a.0);
@@ -214,34 +190,26 @@ fn read_ground_truth(
 
 /// Runs `raypath localize`.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let json = args.json;
+    let json = super::console::json();
     if args.particles == 0 {
-        return Err(Failure::input("--particles must be at least 1", json));
+        return Err(Failure::input("--particles must be at least 1"));
     }
     if args.beam_step == 0 {
-        return Err(Failure::input("--beam-step must be at least 1", json));
+        return Err(Failure::input("--beam-step must be at least 1"));
     }
     if !(args.effective_beams.is_finite() && args.effective_beams >= 0.0) {
         return Err(Failure::input(
             "--effective-beams must be a finite number ≥ 0",
-            json,
         ));
     }
-    let initial = args
-        .initial
-        .as_deref()
-        .map(|t| parse_initial(t, json))
-        .transpose()?;
-    let mut recording = Recording::open(&args.record, json)?;
-    let map = MapFile::read_file(&args.map).map_err(|e| Failure::input(e, json))?;
+    let initial = args.initial.as_deref().map(parse_initial).transpose()?;
+    let mut recording = Recording::open(&args.record)?;
+    let map = MapFile::read_file(&args.map).map_err(Failure::input)?;
     let StoredStats::Planar(stats) = &map.stats else {
-        return Err(Failure::input(
-            format!(
-                "{}: a 3-D map; raypath localize handles 2-D maps",
-                args.map.display()
-            ),
-            json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: a 3-D map; raypath localize handles 2-D maps",
+            args.map.display()
+        )));
     };
     let kind = match args.model_override {
         Some(model) => model.into(),
@@ -259,23 +227,20 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     };
     let model = spec
         .build(stats, map.mapping.range)
-        .map_err(|e| Failure::input(format!("{}: {e}", args.map.display()), json))?;
+        .map_err(|e| Failure::input(format!("{}: {e}", args.map.display())))?;
 
-    let scans = args
-        .source
-        .read_frames(&args.log)
-        .map_err(|e| Failure::input(e, json))?;
+    let scans = args.source.read_frames(&args.log).map_err(Failure::input)?;
     let Some(first) = scans.first() else {
-        return Err(Failure::input(
-            format!("{}: no laser scans", args.log.display()),
-            json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: no laser scans",
+            args.log.display()
+        )));
     };
     let robot_from_laser = first.robot_from_laser();
     let ground_truth = args
         .ground_truth
         .as_deref()
-        .map(|g| read_ground_truth(g, &args.source, robot_from_laser, json))
+        .map(|g| read_ground_truth(g, &args.source, robot_from_laser))
         .transpose()?;
 
     let gt_stamps: Vec<f64> = ground_truth.iter().flatten().map(|g| g.0).collect();
@@ -300,16 +265,13 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let truth_track = match &ground_truth {
         Some(g) => Some(
             PoseTrack::new(g.iter().map(|(t, p)| Stamped::new(*t, *p))).map_err(|e| {
-                Failure::input(
-                    format!(
-                        "{}: {e}",
-                        args.ground_truth
-                            .as_deref()
-                            .unwrap_or(Path::new(""))
-                            .display()
-                    ),
-                    json,
-                )
+                Failure::input(format!(
+                    "{}: {e}",
+                    args.ground_truth
+                        .as_deref()
+                        .unwrap_or(Path::new(""))
+                        .display()
+                ))
             })?,
         ),
         None => None,
@@ -325,8 +287,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         effective_beams: (args.effective_beams > 0.0).then_some(args.effective_beams),
         ..LidarConfig::default()
     };
-    let measurement = Scan2Measurement::new(model.as_ref(), robot_from_laser, lidar)
-        .map_err(|e| Failure::input(e, json))?;
+    let measurement =
+        Scan2Measurement::new(model.as_ref(), robot_from_laser, lidar).map_err(Failure::input)?;
     let config = TrackConfig {
         particles: args.particles,
         ..TrackConfig::default()
@@ -340,13 +302,13 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         &config,
         args.seed,
     )
-    .map_err(|e| Failure::input(format!("{}: {e}", args.log.display()), json))?;
+    .map_err(|e| Failure::input(format!("{}: {e}", args.log.display())))?;
     spinner.finish_and_clear();
     super::console::stage("localization", started);
 
     if let Some(out) = &args.out {
         write_tum(out, &result.estimates)
-            .map_err(|e| internal(format!("{}: {e}", out.display()), json))?;
+            .map_err(|e| Failure::internal(format!("{}: {e}", out.display())))?;
     }
     // With ground truth paired to scans, evaluate the estimates at those scans only: between
     // them both tracks are interpolated over the same stamps.
@@ -358,11 +320,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             .filter(|(i, _)| !paired || steps.get(*i).is_some_and(|s| s.force_update))
             .map(|(_, s)| *s),
     )
-    .map_err(|e| internal(e, json))?;
+    .map_err(Failure::internal)?;
     let evaluation = match &truth_track {
         Some(truth) => Some(
             evaluate_trajectory(truth, &estimate_track, &EvaluationConfig::default())
-                .map_err(|e| internal(e, json))?,
+                .map_err(Failure::internal)?,
         ),
         None => None,
     };

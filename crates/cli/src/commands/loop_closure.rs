@@ -158,9 +158,6 @@ pub struct Args {
     /// Kidnapped mode: keep this many best candidates per query (default all).
     #[arg(long, value_name = "K")]
     pub top_k: Option<usize>,
-    /// Print one JSON document on standard output.
-    #[arg(long)]
-    pub json: bool,
     /// How to read the input and the ground truth.
     #[command(flatten)]
     pub source: SourceArgs,
@@ -187,7 +184,7 @@ fn loop_config(args: &Args) -> LoopConfig {
 }
 
 fn check_args(args: &Args) -> Result<(), Failure> {
-    let bad = |m: &str| Err(Failure::input(m, args.json));
+    let bad = |m: &str| Err(Failure::input(m));
     if !args.min_score.is_finite() {
         return bad("--min-score: must be a finite number");
     }
@@ -216,8 +213,8 @@ fn check_args(args: &Args) -> Result<(), Failure> {
 /// Runs `raypath loop-closure`.
 pub fn run(args: &Args) -> Result<(), Failure> {
     check_args(args)?;
-    let mut recording = Recording::open(&args.record, args.json)?;
-    let input = read_input(&args.input, &args.source, args.max_frames, args.json)?;
+    let mut recording = Recording::open(&args.record)?;
+    let input = read_input(&args.input, &args.source, args.max_frames)?;
     let truth = match &args.ground_truth {
         None => None,
         Some(path) => {
@@ -231,15 +228,12 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                     seconds: args.exclusion_seconds,
                 },
             };
-            Some((
-                path,
-                ground_truth(path, &args.source, &input, &params, args.json)?,
-            ))
+            Some((path, ground_truth(path, &args.source, &input, &params)?))
         }
     };
     let outcome = dispatch(args, &input)?;
     let config = loop_config(args);
-    let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()), args.json);
+    let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()));
     let loops = detect_loops(&config, &outcome.candidates).map_err(place)?;
     let summary = match &truth {
         None => None,
@@ -252,7 +246,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         };
         record(recording, &input, poses.unwrap_or_default(), &loops)?;
     }
-    if args.json {
+    if super::console::json() {
         let mut doc = to_json(&input, &outcome, &loops, summary.as_ref());
         super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
@@ -329,8 +323,7 @@ pub enum IbuildScoreArg {
 
 /// Builds the recognizer and runs it.
 fn dispatch(args: &Args, input: &Input) -> Result<Outcome, Failure> {
-    let json = args.json;
-    let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()), json);
+    let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()));
     match args.method {
         Method::Ibuild => {
             let config = IbuildConfig {
@@ -384,7 +377,7 @@ fn execute<R: PlaceRecognizer + Sync>(
     args: &Args,
     input: &Input,
 ) -> Result<Outcome, Failure> {
-    let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()), args.json);
+    let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()));
     let n = input.len();
     let source = |i| input.frame(i);
     match args.mode {
@@ -431,13 +424,12 @@ fn dbow_vocabulary(
     input: &Input,
     config: &DbowConfig,
 ) -> Result<BinaryVocabulary, Failure> {
-    let json = args.json;
     let vocabulary = match &args.vocabulary {
         Some(path) => {
             let file = std::fs::File::open(path)
-                .map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))?;
+                .map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
             BinaryVocabulary::from_reader(std::io::BufReader::new(file))
-                .map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))?
+                .map_err(|e| Failure::input(format!("{}: {e}", path.display())))?
         }
         None => {
             super::console::warn(
@@ -445,8 +437,7 @@ fn dbow_vocabulary(
                  not the offline protocol (a vocabulary from independent images) and flatters \
                  DBoW",
             );
-            let place =
-                |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()), json);
+            let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()));
             let mut images = Vec::with_capacity(input.len());
             for i in 0..input.len() {
                 let frame = input.frame(i).map_err(place)?;
@@ -463,11 +454,7 @@ fn dbow_vocabulary(
             let file = std::fs::File::create(path)?;
             vocabulary.to_writer(std::io::BufWriter::new(file))
         };
-        write().map_err(|e| Failure {
-            message: format!("{}: {e}", path.display()),
-            bad_input: false,
-            json,
-        })?;
+        write().map_err(|e| Failure::internal(format!("{}: {e}", path.display())))?;
     }
     Ok(vocabulary)
 }

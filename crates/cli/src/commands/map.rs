@@ -132,9 +132,6 @@ pub struct Args {
     /// dense).
     #[arg(long)]
     pub sparse: bool,
-    /// Print one JSON document on standard output.
-    #[arg(long)]
-    pub json: bool,
     /// How to read the input.
     #[command(flatten)]
     pub source: SourceArgs,
@@ -148,9 +145,9 @@ const MAX_CELLS: usize = 200_000_000;
 
 /// Runs `raypath map`.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let mut recording = Recording::open(&args.record, args.json)?;
+    let mut recording = Recording::open(&args.record)?;
     let report = build(args, recording.as_mut())?;
-    if args.json {
+    if super::console::json() {
         let mut doc = report.json();
         super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
@@ -170,8 +167,8 @@ pub fn build_json(args: &Args) -> Result<serde_json::Value, Failure> {
 fn build(args: &Args, recording: Option<&mut Recording>) -> Result<Report, Failure> {
     let started = Instant::now();
     let config = check_args(args)?;
-    let input = Input::read(&args.input, &args.source, args.ray_step, &config)
-        .map_err(|e| Failure::input(e, args.json))?;
+    let input =
+        Input::read(&args.input, &args.source, args.ray_step, &config).map_err(Failure::input)?;
     let mapping_started = Instant::now();
     let (stats, dims) = match &input {
         Input::Planar { scans, bounds, .. } => {
@@ -231,7 +228,6 @@ fn check_args(args: &Args) -> Result<MappingConfig, Failure> {
     let bad = |message: String| Failure {
         message,
         bad_input: true,
-        json: args.json,
     };
     if args.posterior && args.model == Model::LogOdds {
         return Err(bad(
@@ -256,27 +252,21 @@ fn check_args(args: &Args) -> Result<MappingConfig, Failure> {
 }
 
 fn grid_failure(args: &Args, error: impl std::fmt::Display) -> Failure {
-    Failure::input(
-        format!(
-            "{}: cannot build a grid of {} m cells over the data: {error}",
-            args.input.display(),
-            args.resolution
-        ),
-        args.json,
-    )
+    Failure::input(format!(
+        "{}: cannot build a grid of {} m cells over the data: {error}",
+        args.input.display(),
+        args.resolution
+    ))
 }
 
 fn check_size(args: &Args, cells: usize) -> Result<(), Failure> {
     if cells > MAX_CELLS {
-        return Err(Failure::input(
-            format!(
-                "{}: the map would have {cells} cells of {} m (at most {MAX_CELLS}); use a \
+        return Err(Failure::input(format!(
+            "{}: the map would have {cells} cells of {} m (at most {MAX_CELLS}); use a \
                  coarser --resolution or a smaller --max-range",
-                args.input.display(),
-                args.resolution
-            ),
-            args.json,
-        ));
+            args.input.display(),
+            args.resolution
+        )));
     }
     Ok(())
 }
@@ -296,16 +286,13 @@ fn with_suffix(prefix: &Path, suffix: &str) -> PathBuf {
 }
 
 fn write_outputs(args: &Args, file: &MapFile) -> Result<Written, Failure> {
-    let failure = |e: raypath_sensor_models::SensorModelError| Failure {
-        message: e.to_string(),
-        bad_input: false,
-        json: args.json,
-    };
+    let failure = |e: raypath_sensor_models::SensorModelError| Failure::internal(e.to_string());
     if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| Failure {
-            message: format!("{}: cannot create the directory: {e}", dir.display()),
-            bad_input: false,
-            json: args.json,
+        std::fs::create_dir_all(dir).map_err(|e| {
+            Failure::internal(format!(
+                "{}: cannot create the directory: {e}",
+                dir.display()
+            ))
         })?;
     }
     let projected;

@@ -39,24 +39,30 @@ pub struct Failure {
     pub message: String,
     /// True for bad input (exit code 2), false for other failures (exit code 1).
     pub bad_input: bool,
-    /// Also print `{"error": message}` on standard output.
-    pub json: bool,
 }
 
 impl Failure {
-    /// A failure caused by the user's input.
-    pub fn input(error: impl std::fmt::Display, json: bool) -> Self {
+    /// A failure caused by the user's input (exit code 2).
+    pub fn input(error: impl std::fmt::Display) -> Self {
         Self {
             message: error.to_string(),
             bad_input: true,
-            json,
         }
     }
 
-    /// Prints the failure and returns the exit code.
+    /// Any other failure (exit code 1).
+    pub fn internal(error: impl std::fmt::Display) -> Self {
+        Self {
+            message: error.to_string(),
+            bad_input: false,
+        }
+    }
+
+    /// Prints the failure (on standard error, and under `--json` as `{"error": …}` on
+    /// standard output) and returns the exit code. The one error path of every subcommand.
     pub fn report(&self) -> ExitCode {
         eprintln!("error: {}", self.message);
-        if self.json {
+        if console::json() {
             println!("{}", serde_json::json!({ "error": self.message }));
         }
         ExitCode::from(if self.bad_input { 2 } else { 1 })

@@ -96,9 +96,6 @@ pub struct Args {
     /// Write the map: `.bt` (OctoMap tree) or `.ply` (occupied cuboids).
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
-    /// Print one JSON document on standard output.
-    #[arg(long)]
-    pub json: bool,
     /// How to read a bag.
     #[command(flatten)]
     pub source: SourceArgs,
@@ -115,20 +112,17 @@ type Scans = Vec<(Pose3, PointCloud)>;
 
 /// The scans with their times: a sequence's scan times, else the scan index as seconds.
 fn load(args: &Args) -> Result<(Scans, Vec<f64>), Failure> {
-    let bad = |e: raypath_io::Error| Failure::input(e, args.json);
+    let bad = |e: raypath_io::Error| Failure::input(e);
     let path = &args.input;
     let limit = args.scans.unwrap_or(usize::MAX);
     let indices = |n: usize| (0..n).map(|i| i as f64).collect();
     if path.is_dir() || is_bag(path) {
         let sequence = args.source.open_sweeps(path).map_err(bad)?;
         let Some((poses, _)) = sweep_poses(&sequence) else {
-            return Err(Failure::input(
-                format!(
-                    "{}: no sensor poses (reference or odometry)",
-                    sequence.name.display()
-                ),
-                args.json,
-            ));
+            return Err(Failure::input(format!(
+                "{}: no sensor poses (reference or odometry)",
+                sequence.name.display()
+            )));
         };
         let mut scans = Vec::new();
         for (i, pose) in poses.iter().enumerate().take(limit) {
@@ -160,28 +154,20 @@ fn load(args: &Args) -> Result<(Scans, Vec<f64>), Failure> {
     Ok((scans, stamps))
 }
 
-fn write_map(grid: &RtreeGrid, out: &Path, json: bool) -> Result<(), Failure> {
+fn write_map(grid: &RtreeGrid, out: &Path) -> Result<(), Failure> {
     let name = out.to_string_lossy().to_lowercase();
     if name.ends_with(".bt") {
-        raypath_io::octomap::write_bt_file(out, &grid.to_octree())
-            .map_err(|e| Failure::input(e, json))
+        raypath_io::octomap::write_bt_file(out, &grid.to_octree()).map_err(Failure::input)
     } else if name.ends_with(".ply") {
-        let file = std::fs::File::create(out).map_err(|e| Failure {
-            message: format!("{}: {e}", out.display()),
-            bad_input: false,
-            json,
-        })?;
+        let file = std::fs::File::create(out)
+            .map_err(|e| Failure::internal(format!("{}: {e}", out.display())))?;
         grid.write_occupied_ply(std::io::BufWriter::new(file))
-            .map_err(|e| Failure {
-                message: format!("{}: {e}", out.display()),
-                bad_input: false,
-                json,
-            })
+            .map_err(|e| Failure::internal(format!("{}: {e}", out.display())))
     } else {
-        Err(Failure::input(
-            format!("{}: --out must end in .bt or .ply", out.display()),
-            json,
-        ))
+        Err(Failure::input(format!(
+            "{}: --out must end in .bt or .ply",
+            out.display()
+        )))
     }
 }
 
@@ -198,10 +184,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     if let Some(out) = &args.out {
         let name = out.to_string_lossy().to_lowercase();
         if !(name.ends_with(".bt") || name.ends_with(".ply")) {
-            return Err(Failure::input(
-                format!("{}: --out must end in .bt or .ply", out.display()),
-                args.json,
-            ));
+            return Err(Failure::input(format!(
+                "{}: --out must end in .bt or .ply",
+                out.display()
+            )));
         }
     }
     let mut config = GridConfig::with(args.resolution, args.max_entries, model);
@@ -209,8 +195,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     config.fusion = !args.no_fusion;
     config.fusion_rule = fusion_rule;
     config.fusion_interval_scans = args.fusion_interval;
-    let mut grid = RtreeGrid::new(config).map_err(|e| Failure::input(e, args.json))?;
-    let mut recording = Recording::open(&args.record, args.json)?;
+    let mut grid = RtreeGrid::new(config).map_err(Failure::input)?;
+    let mut recording = Recording::open(&args.record)?;
     let (scans, stamps) = load(args)?;
     check_lattice(args, &scans)?;
     let points: usize = scans.iter().map(|(_, c)| c.num_valid()).sum();
@@ -232,13 +218,13 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let access_secs = started.elapsed().as_secs_f64();
     let stats = grid.stats();
     if let Some(out) = &args.out {
-        write_map(&grid, out, args.json)?;
+        write_map(&grid, out)?;
     }
     if let Some(recording) = &mut recording {
         record(recording, &grid, &scans, &stamps)?;
     }
     let per_point_us = insert_secs / points.max(1) as f64 * 1e6;
-    if args.json {
+    if super::console::json() {
         let mut doc = json!({
             "input": args.input.display().to_string(),
             "scans": scans.len(),
@@ -318,16 +304,13 @@ fn check_lattice(args: &Args, scans: &Scans) -> Result<(), Failure> {
         }
     }
     let Some(scan) = first else { return Ok(()) };
-    Err(Failure::input(
-        format!(
-            "{}: {outside} of {total} points (first in scan {scan}) lie beyond the grid's \
+    Err(Failure::input(format!(
+        "{}: {outside} of {total} points (first in scan {scan}) lie beyond the grid's \
              lattice, which reaches ±{reach:.3} m from the origin at --resolution {} m \
              (32768 base cubes per axis); choose a coarser --resolution",
-            args.input.display(),
-            args.resolution
-        ),
-        args.json,
-    ))
+        args.input.display(),
+        args.resolution
+    )))
 }
 
 /// `--record`: the sensor poses (`/tf`, `/trajectory`), the occupied leaves' centres

@@ -111,9 +111,6 @@ pub struct Args {
     /// Write one label per point (0 = no plane) to this file.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
-    /// Print one JSON document on standard output.
-    #[arg(long)]
-    pub json: bool,
     /// How to read a bag.
     #[command(flatten)]
     pub source: SourceArgs,
@@ -125,7 +122,7 @@ pub struct Args {
 /// The organized scan and its time: a PCD file (time 0), or sweep `--frame-index` of a bag
 /// or an Ouster capture.
 fn read_scan(args: &Args) -> Result<(PointCloud, f64), Failure> {
-    let bad = |e: raypath_io::Error| Failure::input(e, args.json);
+    let bad = |e: raypath_io::Error| Failure::input(e);
     if !is_bag(&args.scan) && !raypath_io::ouster::is_capture_name(&args.scan) {
         let options = ReadOptions {
             label_from: raypath_io::pcd::LabelSource::None,
@@ -134,29 +131,23 @@ fn read_scan(args: &Args) -> Result<(PointCloud, f64), Failure> {
     }
     let sequence = args.source.open_sweeps(&args.scan).map_err(bad)?;
     if args.frame_index >= sequence.len() {
-        return Err(Failure::input(
-            format!(
-                "{}: --frame-index {} but it has {} sweep(s)",
-                sequence.name.display(),
-                args.frame_index,
-                sequence.len()
-            ),
-            args.json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: --frame-index {} but it has {} sweep(s)",
+            sequence.name.display(),
+            args.frame_index,
+            sequence.len()
+        )));
     }
     let cloud = sequence.sweep(args.frame_index).map_err(bad)?;
     if !cloud.is_organized() {
-        return Err(Failure::input(
-            format!(
-                "{}: sweep {} is not organized ({} × {} points); plane extraction needs a \
+        return Err(Failure::input(format!(
+            "{}: sweep {} is not organized ({} × {} points); plane extraction needs a \
                  range image (PointCloud2 with height > 1)",
-                sequence.name.display(),
-                args.frame_index,
-                cloud.width,
-                cloud.height
-            ),
-            args.json,
-        ));
+            sequence.name.display(),
+            args.frame_index,
+            cloud.width,
+            cloud.height
+        )));
     }
     let stamp = sequence
         .stamps_secs
@@ -224,7 +215,6 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                 super::choice_name(&args.preset)
             ),
             bad_input: false,
-            json: args.json,
         });
     };
     if let Some(e) = args.max_increment {
@@ -233,10 +223,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     if let Some(l) = args.l_max {
         params.l_max_m = l;
     }
-    params
-        .validate()
-        .map_err(|e| Failure::input(e, args.json))?;
-    let mut recording = Recording::open(&args.record, args.json)?;
+    params.validate().map_err(Failure::input)?;
+    let mut recording = Recording::open(&args.record)?;
     let (cloud, stamp) = read_scan(args)?;
     let started = Instant::now();
     let result = match args.method {
@@ -254,8 +242,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         }
         MethodArg::Ppe => extract(&cloud, &params),
     };
-    let seg =
-        result.map_err(|e| Failure::input(format!("{}: {e}", args.scan.display()), args.json))?;
+    let seg = result.map_err(|e| Failure::input(format!("{}: {e}", args.scan.display())))?;
     let seconds = started.elapsed().as_secs_f64();
     if let Some(out) = &args.out {
         let write = || -> std::io::Result<()> {
@@ -265,16 +252,12 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             }
             w.flush()
         };
-        write().map_err(|e| Failure {
-            message: format!("{}: {e}", out.display()),
-            bad_input: false,
-            json: args.json,
-        })?;
+        write().map_err(|e| Failure::internal(format!("{}: {e}", out.display())))?;
     }
     if let Some(recording) = &mut recording {
         record(recording, stamp, &cloud, &seg)?;
     }
-    if args.json {
+    if super::console::json() {
         let planes: Vec<_> = seg
             .planes
             .iter()

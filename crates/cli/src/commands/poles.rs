@@ -92,9 +92,6 @@ pub struct Common {
     /// measured from one pose; `origin` otherwise.
     #[arg(long, value_enum, default_value_t = SweepTimingArg::Auto)]
     pub sweep_timing: SweepTimingArg,
-    /// Print one JSON document on standard output.
-    #[arg(long)]
-    pub json: bool,
     /// How to read a bag.
     #[command(flatten)]
     pub source: SourceArgs,
@@ -195,9 +192,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
 }
 
 fn open(common: &Common) -> Result<(Drive, Preset, std::ops::Range<usize>), Failure> {
-    let json = common.json;
     let mut drive = Drive::open_with(&common.sequence, &common.source.sweep_options())
-        .map_err(|e| Failure::input(e, json))?;
+        .map_err(Failure::input)?;
     let kitti_timing = match common.sweep_timing {
         SweepTimingArg::Kitti => true,
         SweepTimingArg::Origin => false,
@@ -215,15 +211,12 @@ fn open(common: &Common) -> Result<(Drive, Preset, std::ops::Range<usize>), Fail
         },
     };
     if common.from >= drive.len() {
-        return Err(Failure::input(
-            format!(
-                "{}: --from {} but the sequence has {} scan(s)",
-                common.sequence.display(),
-                common.from,
-                drive.len()
-            ),
-            json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: --from {} but the sequence has {} scan(s)",
+            common.sequence.display(),
+            common.from,
+            drive.len()
+        )));
     }
     let end = common
         .max_scans
@@ -282,20 +275,20 @@ fn mapping_track(drive: &Drive) -> Vec<Pose3> {
 fn extract(args: &ExtractArgs) -> Result<(), Failure> {
     let c = &args.common;
     let (drive, preset, range) = open(c)?;
-    let mut recording = Recording::open(&c.record, c.json)?;
+    let mut recording = Recording::open(&c.record)?;
     let track = mapping_track(&drive);
-    let (maps, totals) = local_maps(&drive, &track, range.clone(), &preset, |_, _| {})
-        .map_err(|e| Failure::input(e, c.json))?;
+    let (maps, totals) =
+        local_maps(&drive, &track, range.clone(), &preset, |_, _| {}).map_err(Failure::input)?;
     let poles = maps.first().map(|m| m.poles.clone()).unwrap_or_default();
     let scans = maps.first().map_or(0, |m| m.scans.len());
     if let Some(out) = &args.out {
-        write_pole_csv(out, &poles).map_err(|e| Failure::input(e, c.json))?;
+        write_pole_csv(out, &poles).map_err(Failure::input)?;
     }
     if let Some(recording) = &mut recording {
         let used = maps.first().map(|m| m.scans.clone()).unwrap_or_default();
-        record::mapping(recording, &drive, &track, &used, &poles, c.json)?;
+        record::mapping(recording, &drive, &track, &used, &poles)?;
     }
-    if c.json {
+    if super::console::json() {
         let mut doc = json!({
             "sequence": c.sequence.display().to_string(),
             "preset": preset_name(c, &drive),
@@ -323,18 +316,18 @@ fn extract(args: &ExtractArgs) -> Result<(), Failure> {
 fn map(args: &MapArgs) -> Result<(), Failure> {
     let c = &args.common;
     let (drive, preset, range) = open(c)?;
-    let mut recording = Recording::open(&c.record, c.json)?;
+    let mut recording = Recording::open(&c.record)?;
     let track = mapping_track(&drive);
     let scans = range.len();
-    let (maps, totals) = local_maps(&drive, &track, range.clone(), &preset, |_, _| {})
-        .map_err(|e| Failure::input(e, c.json))?;
+    let (maps, totals) =
+        local_maps(&drive, &track, range.clone(), &preset, |_, _| {}).map_err(Failure::input)?;
     let poles = reference_map(&maps, &preset);
-    write_pole_csv(&args.out, &poles).map_err(|e| Failure::input(e, c.json))?;
+    write_pole_csv(&args.out, &poles).map_err(Failure::input)?;
     if let Some(recording) = &mut recording {
         let used: Vec<usize> = range.collect();
-        record::mapping(recording, &drive, &track, &used, &poles, c.json)?;
+        record::mapping(recording, &drive, &track, &used, &poles)?;
     }
-    if c.json {
+    if super::console::json() {
         let mut doc = json!({
             "sequence": c.sequence.display().to_string(),
             "preset": preset_name(c, &drive),
@@ -363,25 +356,22 @@ fn map(args: &MapArgs) -> Result<(), Failure> {
 
 fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
     let c = &args.common;
-    let json = c.json;
+    let json = super::console::json();
     if args.runs == 0 {
-        return Err(Failure::input("--runs must be at least 1", json));
+        return Err(Failure::input("--runs must be at least 1"));
     }
     let (drive, mut preset, range) = open(c)?;
     if let Some(n) = args.particles {
         preset.filter.particles = n;
     }
-    preset
-        .filter
-        .validate()
-        .map_err(|e| Failure::input(e, json))?;
-    let mut recording = Recording::open(&c.record, json)?;
-    let map = read_pole_csv(&args.map).map_err(|e| Failure::input(e, json))?;
+    preset.filter.validate().map_err(Failure::input)?;
+    let mut recording = Recording::open(&c.record)?;
+    let map = read_pole_csv(&args.map).map_err(Failure::input)?;
     if map.is_empty() {
-        return Err(Failure::input(
-            format!("{}: the pole map is empty", args.map.display()),
-            json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: the pole map is empty",
+            args.map.display()
+        )));
     }
     let start = match (&args.start, &drive.ground_truth) {
         (Some(v), _) => match v.as_slice() {
@@ -391,7 +381,6 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
             _ => {
                 return Err(Failure::input(
                     "--start needs three finite numbers x,y,theta",
-                    json,
                 ));
             }
         },
@@ -400,19 +389,16 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
             .map(Pose3::to_planar)
             .unwrap_or_default(),
         (None, None) => {
-            return Err(Failure::input(
-                format!(
-                    "{}: no ground-truth poses; give the initial pose with --start x,y,theta",
-                    c.sequence.display()
-                ),
-                json,
-            ));
+            return Err(Failure::input(format!(
+                "{}: no ground-truth poses; give the initial pose with --start x,y,theta",
+                c.sequence.display()
+            )));
         }
     };
     // Online poles: local maps along the odometry (KITTI: the poses, see the module docs).
     let registration = drive.odometry.clone();
     let (maps, _) = local_maps(&drive, &registration, range.clone(), &preset, |_, _| {})
-        .map_err(|e| Failure::input(e, json))?;
+        .map_err(Failure::input)?;
     let online = online_poles(&maps, &preset);
     let noise = match drive.format {
         DriveFormat::Kitti => OdometryNoise::Relative { fraction: 0.02 },
@@ -437,11 +423,11 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
             start,
             args.seed + r as u64,
         )
-        .map_err(|e| Failure::input(e, json))?;
+        .map_err(Failure::input)?;
         if r == 0
             && let Some(recording) = &mut recording
         {
-            record::localization(recording, &drive, range.clone(), &map, &track, json)?;
+            record::localization(recording, &drive, range.clone(), &map, &track)?;
         }
         if let Some(last) = track.poses().last() {
             finals.push(json!({"x": last.x(), "y": last.y(), "theta": last.theta()}));
@@ -452,9 +438,9 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
                 drive.stamps_secs[range.start..end].to_vec(),
                 gt[range.start..end].iter().map(Pose3::to_planar).collect(),
             )
-            .map_err(|e| Failure::input(e, json))?;
+            .map_err(Failure::input)?;
             let evaluation = evaluate_trajectory(&gt_track, &track, &EvaluationConfig::default())
-                .map_err(|e| Failure::input(e, json))?;
+                .map_err(Failure::input)?;
             runs.push(RunResult {
                 evaluation,
                 updates,

@@ -93,9 +93,6 @@ pub struct Args {
     /// Write an SVG picture of scan and polylines.
     #[arg(long, value_name = "FILE")]
     pub svg: Option<PathBuf>,
-    /// Print one JSON document on standard output.
-    #[arg(long)]
-    pub json: bool,
     /// How to read the log.
     #[command(flatten)]
     pub source: SourceArgs,
@@ -120,13 +117,10 @@ fn config(args: &Args) -> Result<PolylineConfig, Failure> {
         (MethodArg::Ief, false) => Method::Ief,
         (MethodArg::Sam, false) => Method::Sam,
         (other @ (MethodArg::Vvl | MethodArg::Ief | MethodArg::Sam), true) => {
-            return Err(Failure::input(
-                format!(
-                    "--optimize applies to ple only, not {}",
-                    super::choice_name(&other)
-                ),
-                args.json,
-            ));
+            return Err(Failure::input(format!(
+                "--optimize applies to ple only, not {}",
+                super::choice_name(&other)
+            )));
         }
     };
     let optimizer = match args.solver {
@@ -141,9 +135,7 @@ fn config(args: &Args) -> Result<PolylineConfig, Failure> {
         optimizer,
         ..PolylineConfig::default()
     };
-    config
-        .validate()
-        .map_err(|e| Failure::input(e, args.json))?;
+    config.validate().map_err(Failure::input)?;
     Ok(config)
 }
 
@@ -157,14 +149,11 @@ fn read_scans(args: &Args) -> Result<Vec<(usize, PlanarFrame)>, Failure> {
     wanted.sort_unstable();
     wanted.dedup();
     let last = wanted.last().copied().unwrap_or(0);
-    let source = args
-        .source
-        .open_planar(&args.log)
-        .map_err(|e| Failure::input(e, args.json))?;
+    let source = args.source.open_planar(&args.log).map_err(Failure::input)?;
     let mut scans = Vec::new();
     let mut index = 0usize;
     for frame in source {
-        let frame = frame.map_err(|e| Failure::input(e, args.json))?;
+        let frame = frame.map_err(Failure::input)?;
         if args.all || wanted.binary_search(&index).is_ok() {
             scans.push((index, frame));
         }
@@ -174,13 +163,10 @@ fn read_scans(args: &Args) -> Result<Vec<(usize, PlanarFrame)>, Failure> {
         }
     }
     if !args.all && index <= last {
-        return Err(Failure::input(
-            format!(
-                "{}: scan {last} requested, but the log has {index} laser scan(s)",
-                args.log.display()
-            ),
-            args.json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: scan {last} requested, but the log has {index} laser scan(s)",
+            args.log.display()
+        )));
     }
     Ok(scans)
 }
@@ -199,7 +185,7 @@ fn svg_path(base: &Path, index: usize, several: bool) -> PathBuf {
 /// Runs `raypath polylines`.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let config = config(args)?;
-    let mut recording = Recording::open(&args.record, args.json)?;
+    let mut recording = Recording::open(&args.record)?;
     let scans = read_scans(args)?;
     let several = scans.len() > 1;
     let mut results = Vec::with_capacity(scans.len());
@@ -208,17 +194,13 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         bar.inc(1);
         let scan = &frame.scan;
         let place = || format!("{}: scan {index}", args.log.display());
-        let map = extract(scan, &config)
-            .map_err(|e| Failure::input(format!("{}: {e}", place()), args.json))?;
-        let m = ray_metrics(scan, &map)
-            .map_err(|e| Failure::input(format!("{}: {e}", place()), args.json))?;
+        let map =
+            extract(scan, &config).map_err(|e| Failure::input(format!("{}: {e}", place())))?;
+        let m = ray_metrics(scan, &map).map_err(|e| Failure::input(format!("{}: {e}", place())))?;
         if let Some(base) = &args.svg {
             let path = svg_path(base, *index, several);
-            std::fs::write(&path, scan_svg(scan, &map, 800.0)).map_err(|e| Failure {
-                message: format!("{}: {e}", path.display()),
-                bad_input: false,
-                json: args.json,
-            })?;
+            std::fs::write(&path, scan_svg(scan, &map, 800.0))
+                .map_err(|e| Failure::internal(format!("{}: {e}", path.display())))?;
         }
         if let Some(recording) = &mut recording {
             record(recording, frame, &map)?;
@@ -230,7 +212,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             f: m.f,
         });
     }
-    if args.json {
+    if super::console::json() {
         let mut doc = to_json(args, &config, &results);
         super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");

@@ -60,28 +60,27 @@ pub struct RecordArgs {
 /// and the latest stamp written.
 pub struct Recording {
     recorder: Recorder,
-    json: bool,
     end_stamp: f64,
 }
 
 impl Recording {
     /// Creates the recording `--record` names (and its directory); `None` without
     /// `--record`. `json` is the command's `--json` (for the failure report).
-    pub fn open(args: &RecordArgs, json: bool) -> Result<Option<Recording>, Failure> {
+    pub fn open(args: &RecordArgs) -> Result<Option<Recording>, Failure> {
         let Some(path) = &args.record else {
             return Ok(None);
         };
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(|e| Failure {
-                message: format!("{}: cannot create the directory: {e}", dir.display()),
-                bad_input: false,
-                json,
+            std::fs::create_dir_all(dir).map_err(|e| {
+                Failure::internal(format!(
+                    "{}: cannot create the directory: {e}",
+                    dir.display()
+                ))
             })?;
         }
-        let recorder = Recorder::create(path).map_err(|e| failure(e, json))?;
+        let recorder = Recorder::create(path).map_err(Failure::internal)?;
         Ok(Some(Recording {
             recorder,
-            json,
             end_stamp: 0.0,
         }))
     }
@@ -93,7 +92,7 @@ impl Recording {
     }
 
     fn stamped(&mut self, stamp_secs: f64, result: raypath_io::Result<()>) -> Result<(), Failure> {
-        result.map_err(|e| failure(e, self.json))?;
+        result.map_err(Failure::internal)?;
         if stamp_secs > self.end_stamp {
             self.end_stamp = stamp_secs;
         }
@@ -258,10 +257,8 @@ pub fn finish(recording: Option<Recording>, doc: Option<&mut Value>) -> Result<(
     let Some(recording) = recording else {
         return Ok(());
     };
-    let json = recording.json;
     let path = recording.recorder.path().to_path_buf();
-    let counts: BTreeMap<String, u64> =
-        recording.recorder.finish().map_err(|e| failure(e, json))?;
+    let counts: BTreeMap<String, u64> = recording.recorder.finish().map_err(Failure::internal)?;
     match doc.and_then(Value::as_object_mut) {
         Some(object) => {
             object.insert(
@@ -308,15 +305,6 @@ fn thin(cloud: &PointCloud, max: usize) -> Option<PointCloud> {
     out.label = pick(&cloud.label, &kept);
     out.rgb = pick(&cloud.rgb, &kept);
     Some(out)
-}
-
-/// A recording error: not the user's input (exit code 1); the message names the file.
-fn failure(error: raypath_io::Error, json: bool) -> Failure {
-    Failure {
-        message: error.to_string(),
-        bad_input: false,
-        json,
-    }
 }
 
 #[cfg(test)]

@@ -82,9 +82,6 @@ pub struct Args {
     /// Robust kernel.
     #[arg(long, value_enum, default_value_t = KernelArg::Gm, value_name = "NAME")]
     pub kernel: KernelArg,
-    /// Print one JSON document on standard output.
-    #[arg(long)]
-    pub json: bool,
     /// How to read a bag.
     #[command(flatten)]
     pub source: SourceArgs,
@@ -103,30 +100,25 @@ fn config(args: &Args) -> Result<RegistrationConfig, Failure> {
         kernel,
         ..RegistrationConfig::default()
     };
-    config
-        .validate()
-        .map_err(|e| Failure::input(e, args.json))?;
+    config.validate().map_err(Failure::input)?;
     Ok(config)
 }
 
 /// One scan file in its sensor frame.
-fn read_scan(path: &Path, json: bool) -> Result<PointCloud, Failure> {
-    let bad = |e: raypath_io::Error| Failure::input(e, json);
+fn read_scan(path: &Path) -> Result<PointCloud, Failure> {
+    let bad = |e: raypath_io::Error| Failure::input(e);
     match Format::detect(path).map_err(bad)? {
         Format::KittiVelodyne => raypath_io::kitti::read_velodyne(path).map_err(bad),
         Format::Pcd => Ok(raypath_io::pcd::read_pcd(path, &Default::default())
             .map_err(bad)?
             .cloud),
         Format::Xyz => raypath_io::xyz::read_xyz(path).map_err(bad),
-        other => Err(Failure::input(
-            format!(
-                "{}: a {} is not a single scan; give a KITTI .bin, a PCD file or an x y z \
+        other => Err(Failure::input(format!(
+            "{}: a {} is not a single scan; give a KITTI .bin, a PCD file or an x y z \
                  list (or a sequence alone)",
-                path.display(),
-                other.name()
-            ),
-            json,
-        )),
+            path.display(),
+            other.name()
+        ))),
     }
 }
 
@@ -152,14 +144,13 @@ fn registration_json(r: &Registration) -> Value {
 }
 
 fn pair(args: &Args, target_path: &Path, config: &RegistrationConfig) -> Result<(), Failure> {
-    let source = read_scan(&args.input, args.json)?;
-    let target = read_scan(target_path, args.json)?;
+    let source = read_scan(&args.input)?;
+    let target = read_scan(target_path)?;
     let started = Instant::now();
-    let found = register(&source, &target, &Pose3::identity(), config)
-        .map_err(|e| Failure::input(e, args.json))?;
+    let found = register(&source, &target, &Pose3::identity(), config).map_err(Failure::input)?;
     let seconds = started.elapsed().as_secs_f64();
     let pose = found.target_from_source;
-    if args.json {
+    if super::console::json() {
         let mut out = json!({
             "mode": "pair",
             "source": args.input.display().to_string(),
@@ -256,7 +247,7 @@ fn summary(steps: &[Value]) -> Option<Value> {
 }
 
 fn sequence(args: &Args, config: RegistrationConfig) -> Result<(), Failure> {
-    let bad = |e: raypath_io::Error| Failure::input(e, args.json);
+    let bad = |e: raypath_io::Error| Failure::input(e);
     let sweeps = args.source.open_sweeps(&args.input).map_err(bad)?;
     let n = sweeps.len().min(args.frames.unwrap_or(usize::MAX));
     let reference = sweeps.reference.as_deref();
@@ -264,19 +255,16 @@ fn sequence(args: &Args, config: RegistrationConfig) -> Result<(), Failure> {
         registration: config,
         ..OdometryConfig::default()
     })
-    .map_err(|e| Failure::input(e, args.json))?;
+    .map_err(Failure::input)?;
     let mut steps = Vec::with_capacity(n);
     let bar = super::console::progress(n, "registration");
     for k in 0..n {
         bar.inc(1);
         let cloud = sweeps.sweep(k).map_err(bad)?;
         let started = Instant::now();
-        let step = odometry.register_frame(&cloud).map_err(|e| {
-            Failure::input(
-                format!("{}: sweep {k}: {e}", args.input.display()),
-                args.json,
-            )
-        })?;
+        let step = odometry
+            .register_frame(&cloud)
+            .map_err(|e| Failure::input(format!("{}: sweep {k}: {e}", args.input.display())))?;
         let seconds = started.elapsed().as_secs_f64();
         let poses = odometry.poses();
         let error = match (k, reference) {
@@ -298,7 +286,7 @@ fn sequence(args: &Args, config: RegistrationConfig) -> Result<(), Failure> {
             Some(r) => merge(&mut entry, registration_json(r)),
             None => merge(&mut entry, json!({"iterations": null})),
         }
-        if !args.json {
+        if !super::console::json() {
             print_step(&entry);
         }
         steps.push(entry);
@@ -307,7 +295,7 @@ fn sequence(args: &Args, config: RegistrationConfig) -> Result<(), Failure> {
         raypath_io::kitti::write_poses(out, odometry.poses()).map_err(bad)?;
     }
     let summary = summary(&steps);
-    if args.json {
+    if super::console::json() {
         println!(
             "{}",
             json!({
@@ -377,13 +365,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         {
             sequence(args, config)
         }
-        None => Err(Failure::input(
-            format!(
-                "{}: one scan alone; give a target scan, or a sequence (KITTI directory, NCLT \
+        None => Err(Failure::input(format!(
+            "{}: one scan alone; give a target scan, or a sequence (KITTI directory, NCLT \
                  session, Ouster .pcap, rosbag2 bag)",
-                args.input.display()
-            ),
-            args.json,
-        )),
+            args.input.display()
+        ))),
     }
 }

@@ -111,9 +111,6 @@ pub struct Args {
     /// Process only the first N scans.
     #[arg(long, value_name = "N")]
     pub scans: Option<usize>,
-    /// Print one JSON document on standard output.
-    #[arg(long)]
-    pub json: bool,
     /// How to read the log and the ground truth.
     #[command(flatten)]
     pub source: SourceArgs,
@@ -122,24 +119,13 @@ pub struct Args {
     pub record: RecordArgs,
 }
 
-fn failure(message: impl std::fmt::Display, json: bool) -> Failure {
-    Failure {
-        message: message.to_string(),
-        bad_input: false,
-        json,
-    }
-}
-
 fn config(args: &Args) -> Result<MatcherConfig, Failure> {
     let mode = ResidualMode::from(args.mode);
     let odometry_sigma = match args.odometry_prior.as_deref() {
         None => None,
         Some(&[a, b, c]) => Some([a, b, c]),
         Some(_) => {
-            return Err(Failure::input(
-                "--odometry-prior: expected three values",
-                args.json,
-            ));
+            return Err(Failure::input("--odometry-prior: expected three values"));
         }
     };
     let config = MatcherConfig {
@@ -153,9 +139,7 @@ fn config(args: &Args) -> Result<MatcherConfig, Failure> {
         },
         ..MatcherConfig::default()
     };
-    config
-        .validate()
-        .map_err(|e| Failure::input(e, args.json))?;
+    config.validate().map_err(Failure::input)?;
     Ok(config)
 }
 
@@ -164,46 +148,36 @@ fn config(args: &Args) -> Result<MatcherConfig, Failure> {
 pub(crate) fn read_correction(
     lut: Option<&std::path::Path>,
     mode: ResidualMode,
-    json: bool,
 ) -> Result<Option<IntensityCorrection>, Failure> {
     let Some(path) = lut else {
         if mode != ResidualMode::Occupancy {
-            return Err(Failure::input(
-                format!(
-                    "--mode {}: needs --lut (from raypath calibrate-intensity)",
-                    mode.name()
-                ),
-                json,
-            ));
+            return Err(Failure::input(format!(
+                "--mode {}: needs --lut (from raypath calibrate-intensity)",
+                mode.name()
+            )));
         }
         return Ok(None);
     };
     let text = std::fs::read_to_string(path)
-        .map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))?;
+        .map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
     let model: IntensityCorrection = serde_json::from_str(&text)
-        .map_err(|e| Failure::input(format!("{}:{}: {e}", path.display(), e.line()), json))?;
+        .map_err(|e| Failure::input(format!("{}:{}: {e}", path.display(), e.line())))?;
     if let IntensityCorrection::Lut(lut) = &model {
         lut.validate()
-            .map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))?;
+            .map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
     }
     Ok(Some(model))
 }
 
 /// The scans of the log for the matcher (the logged `world_from_laser` is the odometry).
 fn read_scans(args: &Args) -> Result<Vec<PlanarFrame>, Failure> {
-    let frames = args
-        .source
-        .read_frames(&args.log)
-        .map_err(|e| Failure::input(e, args.json))?;
+    let frames = args.source.read_frames(&args.log).map_err(Failure::input)?;
     if frames.is_empty() {
-        return Err(Failure::input(
-            format!(
-                "{}: no laser scans ({})",
-                args.log.display(),
-                args.source.laser_lines()
-            ),
-            args.json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: no laser scans ({})",
+            args.log.display(),
+            args.source.laser_lines()
+        )));
     }
     Ok(frames)
 }
@@ -225,10 +199,10 @@ fn ipc_stamps(args: &Args, scans: &[PlanarFrame]) -> Result<Vec<f64>, Failure> {
     let Some(lines) = carmen_lines(scans) else {
         return Ok(scans.iter().map(|s| s.stamp_secs).collect());
     };
-    let reader = CarmenReader::open(&args.log).map_err(|e| Failure::input(e, args.json))?;
+    let reader = CarmenReader::open(&args.log).map_err(Failure::input)?;
     let mut ipc: HashMap<u64, f64> = lines.iter().map(|&line| (line, f64::NAN)).collect();
     for record in reader {
-        if let Record::Laser(m) = record.map_err(|e| Failure::input(e, args.json))?
+        if let Record::Laser(m) = record.map_err(Failure::input)?
             && let Some(t) = ipc.get_mut(&m.line)
         {
             *t = m.ipc_timestamp_secs;
@@ -241,14 +215,11 @@ fn ipc_stamps(args: &Args, scans: &[PlanarFrame]) -> Result<Vec<f64>, Failure> {
 }
 
 fn not_carmen(args: &Args) -> Failure {
-    Failure::input(
-        format!(
-            "--corrected-log: {} is not a CARMEN log; a corrected copy is written for CARMEN \
+    Failure::input(format!(
+        "--corrected-log: {} is not a CARMEN log; a corrected copy is written for CARMEN \
              logs only",
-            args.log.display()
-        ),
-        args.json,
-    )
+        args.log.display()
+    ))
 }
 
 /// Copies the log with the estimated poses in the laser messages that were matched (by line);
@@ -263,10 +234,10 @@ fn write_corrected_log(
         return Err(not_carmen(args));
     };
     let estimate: HashMap<u64, Pose2> = lines.into_iter().zip(poses.iter().copied()).collect();
-    let reader = CarmenReader::open(&args.log).map_err(|e| Failure::input(e, args.json))?;
-    let mut writer = CarmenWriter::create(path).map_err(|e| failure(e, args.json))?;
+    let reader = CarmenReader::open(&args.log).map_err(Failure::input)?;
+    let mut writer = CarmenWriter::create(path).map_err(Failure::internal)?;
     for record in reader {
-        let mut record = record.map_err(|e| Failure::input(e, args.json))?;
+        let mut record = record.map_err(Failure::input)?;
         if let Record::Laser(m) = &mut record
             && let Some(pose) = estimate.get(&m.line)
         {
@@ -275,18 +246,15 @@ fn write_corrected_log(
             m.world_from_laser = *pose;
             m.world_from_robot = *pose * robot_from_laser.inverse();
         }
-        writer.record(&record).map_err(|e| failure(e, args.json))?;
+        writer.record(&record).map_err(Failure::internal)?;
     }
-    writer.finish().map_err(|e| failure(e, args.json))?;
+    writer.finish().map_err(Failure::internal)?;
     Ok(())
 }
 
 /// The scans of the ground truth with their reference poses.
 fn read_reference(args: &Args, path: &std::path::Path) -> Result<Vec<(Scan2, Pose2)>, Failure> {
-    let frames = args
-        .source
-        .read_frames(path)
-        .map_err(|e| Failure::input(e, args.json))?;
+    let frames = args.source.read_frames(path).map_err(Failure::input)?;
     let track = reference_track(&frames);
     Ok(frames
         .into_iter()
@@ -299,10 +267,10 @@ fn read_reference(args: &Args, path: &std::path::Path) -> Result<Vec<(Scan2, Pos
 pub fn run(args: &Args) -> Result<(), Failure> {
     let config = config(args)?;
     if !(args.max_range.is_finite() && args.max_range > 0.0) {
-        return Err(Failure::input("--max-range: must be positive", args.json));
+        return Err(Failure::input("--max-range: must be positive"));
     }
-    let lut = read_correction(args.lut.as_deref(), config.mode, args.json)?;
-    let mut recording = Recording::open(&args.record, args.json)?;
+    let lut = read_correction(args.lut.as_deref(), config.mode)?;
+    let mut recording = Recording::open(&args.record)?;
     let mut scans = read_scans(args)?;
     if args.corrected_log.is_some() && carmen_lines(&scans).is_none() {
         return Err(not_carmen(args));
@@ -312,14 +280,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     }
     if config.mode != ResidualMode::Occupancy && !scans.iter().any(|s| s.scan.intensities.is_some())
     {
-        return Err(Failure::input(
-            format!(
-                "{}: --mode {} needs remissions (ROBOTLASER1 lines with intensities)",
-                args.log.display(),
-                config.mode.name()
-            ),
-            args.json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: --mode {} needs remissions (ROBOTLASER1 lines with intensities)",
+            args.log.display(),
+            config.mode.name()
+        )));
     }
     let filter = PointFilter {
         max_range_m: args.max_range,
@@ -329,7 +294,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let start = Instant::now();
     let spinner = super::console::spinner("scan matching");
     let (matcher, results) = run_matcher(&scans, config, &filter, lut.as_ref(), use_odometry)
-        .map_err(|e| failure(e, args.json))?;
+        .map_err(Failure::internal)?;
     spinner.finish_and_clear();
     super::console::stage("scan matching", start);
     let time_s = start.elapsed().as_secs_f64();
@@ -338,7 +303,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         let stamps = ipc_stamps(args, &scans)?;
         let text = tum_lines(stamps.into_iter().zip(poses.iter().copied()));
         std::fs::write(out, text)
-            .map_err(|e| failure(format!("{}: {e}", out.display()), args.json))?;
+            .map_err(|e| Failure::internal(format!("{}: {e}", out.display())))?;
     }
     if let Some(path) = &args.corrected_log {
         write_corrected_log(args, path, &scans, &poses)?;
@@ -346,9 +311,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let mut reflectivity_png = None;
     if let Some(prefix) = &args.map {
         if let Some(level) = matcher.map().levels().first() {
-            write_occupancy_map(level, prefix).map_err(|e| failure(e, args.json))?;
+            write_occupancy_map(level, prefix).map_err(Failure::internal)?;
             let png = PathBuf::from(format!("{}-reflectivity.png", prefix.display()));
-            if write_reflectivity_png(level, &png).map_err(|e| failure(e, args.json))? {
+            if write_reflectivity_png(level, &png).map_err(Failure::internal)? {
                 reflectivity_png = Some(png);
             }
         }
@@ -365,14 +330,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                 reference.iter().map(|(scan, _)| scan),
             );
             if pairs.len() < 2 {
-                return Err(Failure::input(
-                    format!(
-                        "{}: fewer than two scans pair with {} (identical readings)",
-                        path.display(),
-                        args.log.display()
-                    ),
-                    args.json,
-                ));
+                return Err(Failure::input(format!(
+                    "{}: fewer than two scans pair with {} (identical readings)",
+                    path.display(),
+                    args.log.display()
+                )));
             }
             let truth: Vec<Pose2> = pairs
                 .iter()
@@ -390,7 +352,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let scans_per_s = scans.len() as f64 / time_s.max(1e-9);
     let beams = scans.first().map_or(0, |s| s.scan.ranges.len());
     let updates = matcher.map().updates();
-    if args.json {
+    if super::console::json() {
         let mut doc = json!({
             "log": args.log.display().to_string(),
             "mode": config.mode.name(),

@@ -48,9 +48,6 @@ pub struct Args {
     /// rosbag2 bag (directory with metadata.yaml, or .mcap file) with LaserScan and reference
     /// poses.
     pub log: PathBuf,
-    /// Print one JSON document on standard output.
-    #[arg(long)]
-    pub json: bool,
     /// Cell edge of the maps in metres.
     #[arg(long, default_value_t = 0.1, value_name = "M")]
     pub resolution: f64,
@@ -89,29 +86,20 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         max_test_scans: args.max_test_scans,
         ..ScoringConfig::default()
     };
-    config
-        .validate()
-        .map_err(|e| Failure::input(e, args.json))?;
+    config.validate().map_err(Failure::input)?;
     let scans = read_scans(args)?;
     if scans.len() < 2 {
-        return Err(Failure::input(
-            format!(
-                "{}: {} laser scan(s); scoring needs at least 2 (one to map, one to test)",
-                args.log.display(),
-                scans.len()
-            ),
-            args.json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: {} laser scan(s); scoring needs at least 2 (one to map, one to test)",
+            args.log.display(),
+            scans.len()
+        )));
     }
     let report = score_log(&scans, &config)
-        .map_err(|e| Failure::input(format!("{}: {e}", args.log.display()), args.json))?;
-    if args.json {
+        .map_err(|e| Failure::input(format!("{}: {e}", args.log.display())))?;
+    if super::console::json() {
         let text = serde_json::to_string_pretty(&to_json(args, &config, scans.len(), &report))
-            .map_err(|e| Failure {
-                message: e.to_string(),
-                bad_input: false,
-                json: false,
-            })?;
+            .map_err(|e| Failure::internal(e.to_string()))?;
         println!("{text}");
     } else {
         print!("{}", render_text(args, scans.len(), &report));
@@ -121,10 +109,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
 
 /// The laser scans of the log with their reference poses (scans without one are left out).
 fn read_scans(args: &Args) -> Result<Vec<(Pose2, Scan2)>, Failure> {
-    let frames = args
-        .source
-        .read_frames(&args.log)
-        .map_err(|e| Failure::input(e, args.json))?;
+    let frames = args.source.read_frames(&args.log).map_err(Failure::input)?;
     let track = reference_track(&frames);
     Ok(frames
         .into_iter()

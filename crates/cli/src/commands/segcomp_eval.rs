@@ -32,32 +32,26 @@ pub struct Args {
     /// Use strict `>` comparisons (the reference evaluator).
     #[arg(long)]
     pub strict: bool,
-    /// Print one JSON document on standard output.
-    #[arg(long)]
-    pub json: bool,
 }
 
 fn read_labels(args: &Args) -> Result<Vec<Option<u32>>, Failure> {
     let path = &args.labels;
     let file = std::fs::File::open(path)
-        .map_err(|e| Failure::input(format!("{}: {e}", path.display()), args.json))?;
+        .map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
     let mut out = Vec::new();
     for (i, line) in std::io::BufReader::new(file).lines().enumerate() {
-        let line = line
-            .map_err(|e| Failure::input(format!("{}:{}: {e}", path.display(), i + 1), args.json))?;
+        let line =
+            line.map_err(|e| Failure::input(format!("{}:{}: {e}", path.display(), i + 1)))?;
         let t = line.trim();
         if t.is_empty() {
             continue;
         }
         let v: u32 = t.parse().map_err(|_| {
-            Failure::input(
-                format!(
-                    "{}:{}: not a non-negative integer label: {t:?}",
-                    path.display(),
-                    i + 1
-                ),
-                args.json,
-            )
+            Failure::input(format!(
+                "{}:{}: not a non-negative integer label: {t:?}",
+                path.display(),
+                i + 1
+            ))
         })?;
         out.push((v != 0).then_some(v));
     }
@@ -66,41 +60,37 @@ fn read_labels(args: &Args) -> Result<Vec<Option<u32>>, Failure> {
 
 /// Runs the command.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let header = read_pcd_header(&args.truth).map_err(|e| Failure::input(e, args.json))?;
+    let header = read_pcd_header(&args.truth).map_err(Failure::input)?;
     let label_from = if header.field("label").is_some() {
         LabelSource::LabelField
     } else {
         LabelSource::Intensity
     };
-    let pcd = read_pcd(&args.truth, &ReadOptions { label_from })
-        .map_err(|e| Failure::input(e, args.json))?;
+    let pcd = read_pcd(&args.truth, &ReadOptions { label_from }).map_err(Failure::input)?;
     let Some(truth) = pcd.cloud.label else {
-        return Err(Failure::input(
-            format!("{}: no label or intensity field", args.truth.display()),
-            args.json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: no label or intensity field",
+            args.truth.display()
+        )));
     };
     let gt: Vec<Option<u32>> = truth.into_iter().map(Some).collect();
     let ms = read_labels(args)?;
     if ms.len() != gt.len() {
-        return Err(Failure::input(
-            format!(
-                "{}: {} labels, but {} has {} points",
-                args.labels.display(),
-                ms.len(),
-                args.truth.display(),
-                gt.len()
-            ),
-            args.json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: {} labels, but {} has {} points",
+            args.labels.display(),
+            ms.len(),
+            args.truth.display(),
+            gt.len()
+        )));
     }
     let params = HooverParams {
         tolerance: args.tolerance,
         strict: args.strict,
         ..HooverParams::default()
     };
-    let r = compare(&gt, &ms, &params).map_err(|e| Failure::input(e, args.json))?;
-    if args.json {
+    let r = compare(&gt, &ms, &params).map_err(Failure::input)?;
+    if super::console::json() {
         let doc = json!({"f": r.fraction_correct(), "k": r.k_value(), "n_o": r.over, "n_u": r.under,
             "n_m": r.missed, "n_s": r.noise, "correct": r.correct.len(), "gt_planes": r.gt_regions,
             "segments": r.ms_regions, "tolerance": args.tolerance});

@@ -36,12 +36,11 @@ pub fn man(args: &ManArgs, command: clap::Command) -> Result<(), Failure> {
     let Some(dir) = &args.out else {
         return clap_mangen::Man::new(command)
             .render(&mut std::io::stdout())
-            .map_err(|e| Failure::input(format!("standard output: {e}"), false));
+            .map_err(|e| Failure::input(format!("standard output: {e}")));
     };
-    std::fs::create_dir_all(dir)
-        .map_err(|e| Failure::input(format!("{}: {e}", dir.display()), false))?;
+    std::fs::create_dir_all(dir).map_err(|e| Failure::input(format!("{}: {e}", dir.display())))?;
     clap_mangen::generate_to(command, dir)
-        .map_err(|e| Failure::input(format!("{}: {e}", dir.display()), false))?;
+        .map_err(|e| Failure::input(format!("{}: {e}", dir.display())))?;
     println!("man pages written to {}", dir.display());
     Ok(())
 }

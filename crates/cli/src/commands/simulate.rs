@@ -59,9 +59,6 @@ pub struct Args {
     /// semi-kitti: sequence name of the output (`sequences/NN`).
     #[arg(long, default_value = "00")]
     pub sequence: String,
-    /// Print a JSON summary of what was written (files and statistics).
-    #[arg(long)]
-    pub json: bool,
 }
 
 /// Runs `raypath simulate`.
@@ -74,19 +71,12 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let result = generate(args, &progress);
     bar.finish_and_clear();
     let set = result.map_err(|e| match e {
-        SimError::InvalidParameter { .. } | SimError::Io(_) => Failure::input(e, args.json),
-        other => Failure {
-            message: other.to_string(),
-            bad_input: false,
-            json: args.json,
-        },
+        SimError::InvalidParameter { .. } | SimError::Io(_) => Failure::input(e),
+        other => Failure::internal(other.to_string()),
     })?;
-    if args.json {
-        let text = serde_json::to_string_pretty(&set).map_err(|e| Failure {
-            message: e.to_string(),
-            bad_input: false,
-            json: false,
-        })?;
+    if super::console::json() {
+        let text =
+            serde_json::to_string_pretty(&set).map_err(|e| Failure::internal(e.to_string()))?;
         println!("{text}");
     } else {
         println!(

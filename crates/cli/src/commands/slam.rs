@@ -85,9 +85,6 @@ pub struct Args {
     /// Process only the first N scans.
     #[arg(long, value_name = "N")]
     pub scans: Option<usize>,
-    /// Print one JSON document on standard output.
-    #[arg(long)]
-    pub json: bool,
     /// How to read the log and the ground truth.
     #[command(flatten)]
     pub source: SourceArgs,
@@ -120,13 +117,6 @@ impl ModeArg {
 /// Loop closures between scans without a reference are checked against the nearest referenced
 /// scan at most this many scans away, moved by the front-end's relative motion.
 const NEIGHBOUR_GAP: usize = 50;
-fn failure(message: impl std::fmt::Display, json: bool) -> Failure {
-    Failure {
-        message: message.to_string(),
-        bad_input: false,
-        json,
-    }
-}
 
 fn config(args: &Args) -> Result<SlamConfig, Failure> {
     let mut config = SlamConfig::default();
@@ -137,51 +127,40 @@ fn config(args: &Args) -> Result<SlamConfig, Failure> {
     if args.no_loops {
         config.loops = None;
     }
-    config
-        .validate()
-        .map_err(|e| Failure::input(e, args.json))?;
+    config.validate().map_err(Failure::input)?;
     Ok(config)
 }
 
 /// Runs the subcommand.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let config = config(args)?;
-    let lut =
-        super::scan_match::read_correction(args.lut.as_deref(), args.mode.residual(), args.json)?;
-    let mut recording = Recording::open(&args.record, args.json)?;
-    let mut frames = args
-        .source
-        .read_frames(&args.log)
-        .map_err(|e| Failure::input(e, args.json))?;
+    let lut = super::scan_match::read_correction(args.lut.as_deref(), args.mode.residual())?;
+    let mut recording = Recording::open(&args.record)?;
+    let mut frames = args.source.read_frames(&args.log).map_err(Failure::input)?;
     if let Some(n) = args.scans {
         frames.truncate(n.max(1));
     }
     if frames.is_empty() {
-        return Err(Failure::input(
-            format!("{}: no laser scans", args.log.display()),
-            args.json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: no laser scans",
+            args.log.display()
+        )));
     }
-    std::fs::create_dir_all(&args.out).map_err(|e| {
-        failure(
-            format!("{}: cannot create: {e}", args.out.display()),
-            args.json,
-        )
-    })?;
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| Failure::internal(format!("{}: cannot create: {e}", args.out.display())))?;
     let started = Instant::now();
-    let mut slam = Slam::new(config).map_err(|e| Failure::input(e, args.json))?;
+    let mut slam = Slam::new(config).map_err(Failure::input)?;
     if let Some(lut) = lut {
         slam = slam.with_correction(lut);
     }
     let bar = super::console::progress(frames.len(), "slam");
     for (k, frame) in frames.iter().enumerate() {
-        slam.process(frame).map_err(|e| {
-            Failure::input(format!("{}: scan {k}: {e}", args.log.display()), args.json)
-        })?;
+        slam.process(frame)
+            .map_err(|e| Failure::input(format!("{}: scan {k}: {e}", args.log.display())))?;
         bar.inc(1);
     }
     bar.finish_and_clear();
-    let output = slam.finish().map_err(|e| failure(e, args.json))?;
+    let output = slam.finish().map_err(Failure::internal)?;
     super::console::stage("slam", started);
     let seconds = started.elapsed().as_secs_f64();
     let outputs = write_outputs(args, &frames, &output)?;
@@ -194,7 +173,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         record(recording, &frames, &output, &outputs.map_prefix, args.model)?;
     }
     let doc = report(&output, seconds, &outputs, map, evaluation);
-    if args.json {
+    if super::console::json() {
         let mut doc = doc;
         super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
@@ -218,11 +197,10 @@ fn write_outputs(
     out: &SlamOutput,
 ) -> Result<Outputs, Failure> {
     let trajectory = args.out.join("trajectory.txt");
-    out.write_tum(&trajectory)
-        .map_err(|e| failure(e, args.json))?;
+    out.write_tum(&trajectory).map_err(Failure::internal)?;
     let corrected = args.out.join("corrected.log");
     out.write_corrected_log(frames, &corrected)
-        .map_err(|e| failure(e, args.json))?;
+        .map_err(Failure::internal)?;
     let loops = args.out.join("loop_closures.csv");
     let mut text = String::from("scan,anchor_scan,node,submap,x,y,theta,score,source\n");
     for c in &out.loop_closures {
@@ -244,7 +222,7 @@ fn write_outputs(
         ));
     }
     std::fs::write(&loops, text)
-        .map_err(|e| failure(format!("{}: {e}", loops.display()), args.json))?;
+        .map_err(|e| Failure::internal(format!("{}: {e}", loops.display())))?;
     Ok(Outputs {
         trajectory,
         corrected,
@@ -266,7 +244,6 @@ fn rebuild_map(args: &Args, corrected: &Path) -> Result<Value, Failure> {
         ray_step: 1,
         skip_no_returns: true,
         sparse: false,
-        json: args.json,
         source: SourceArgs::default(),
         record: RecordArgs::default(),
     };
@@ -280,20 +257,14 @@ fn evaluate(
     frames: &mut [PlanarFrame],
     out: &SlamOutput,
 ) -> Result<Value, Failure> {
-    let reference = args
-        .source
-        .read_frames(path)
-        .map_err(|e| Failure::input(e, args.json))?;
+    let reference = args.source.read_frames(path).map_err(Failure::input)?;
     let paired = pair_reference(frames, &reference);
     if paired < 2 {
-        return Err(Failure::input(
-            format!(
-                "{}: fewer than two scans pair with {} (identical readings)",
-                path.display(),
-                args.log.display()
-            ),
-            args.json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: fewer than two scans pair with {} (identical readings)",
+            path.display(),
+            args.log.display()
+        )));
     }
     let truth: Vec<_> = frames.iter().map(|f| f.reference).collect();
     let referenced: Vec<usize> = (0..frames.len()).filter(|&i| truth[i].is_some()).collect();
@@ -421,7 +392,7 @@ fn record(
     recording.planar_track(frames, &out.world_from_sensor)?;
     let end = recording.end_stamp();
     let rpmap = map_prefix.with_extension("rpmap");
-    let file = MapFile::read_file(&rpmap).map_err(|e| failure(e, false))?;
+    let file = MapFile::read_file(&rpmap).map_err(Failure::internal)?;
     if let StoredStats::Planar(stats) = &file.stats {
         super::map::record::grid(recording, end, stats, model.picture())?;
     }

@@ -108,42 +108,34 @@ pub fn read_input(
     path: &Path,
     source: &SourceArgs,
     max_frames: Option<usize>,
-    json: bool,
 ) -> Result<Input, Failure> {
     let mut input = if is_bag(path) {
-        match source.open_bag(path).map_err(|e| Failure::input(e, json))? {
-            BagSource::Planar(frames) => read_planar(path, frames, "LaserScan messages", json)?,
+        match source.open_bag(path).map_err(Failure::input)? {
+            BagSource::Planar(frames) => read_planar(path, frames, "LaserScan messages")?,
             BagSource::Sweeps(sequence) => read_sweeps(path, *sequence),
         }
     } else if path.is_dir() {
         let has = |p: &str| path.join(p).exists();
         if has("velodyne") || has("velodyne_sync") || has("sequences") {
-            let sequence = source
-                .open_sweeps(path)
-                .map_err(|e| Failure::input(e, json))?;
+            let sequence = source.open_sweeps(path).map_err(Failure::input)?;
             read_sweeps(path, sequence)
         } else {
-            read_images(path, json)?
+            read_images(path)?
         }
     } else {
-        let frames = source
-            .open_planar(path)
-            .map_err(|e| Failure::input(e, json))?;
+        let frames = source.open_planar(path).map_err(Failure::input)?;
         let kind = match source.laser {
             Laser::Front => "CARMEN front-laser scans",
             Laser::Rear => "CARMEN rear-laser scans",
             Laser::Any => "CARMEN laser scans",
         };
-        let input = read_planar(path, frames, kind, json)?;
+        let input = read_planar(path, frames, kind)?;
         if input.labels.is_empty() {
-            return Err(Failure::input(
-                format!(
-                    "{}: no laser scans ({})",
-                    path.display(),
-                    source.laser_lines()
-                ),
-                json,
-            ));
+            return Err(Failure::input(format!(
+                "{}: no laser scans ({})",
+                path.display(),
+                source.laser_lines()
+            )));
         }
         input
     };
@@ -158,10 +150,7 @@ pub fn read_input(
         }
     }
     if input.labels.is_empty() {
-        return Err(Failure::input(
-            format!("{}: no frames", path.display()),
-            json,
-        ));
+        return Err(Failure::input(format!("{}: no frames", path.display())));
     }
     Ok(input)
 }
@@ -170,11 +159,10 @@ fn read_planar(
     path: &Path,
     source: Box<dyn PlanarSource>,
     kind: &'static str,
-    json: bool,
 ) -> Result<Input, Failure> {
     let frames: Vec<PlanarFrame> = source
         .collect::<raypath_io::Result<_>>()
-        .map_err(|e| Failure::input(e, json))?;
+        .map_err(Failure::input)?;
     let times: Vec<f64> = frames.iter().map(|f| f.stamp_secs).collect();
     let times = times.iter().all(|t| t.is_finite()).then_some(times);
     let poses = reference_track(&frames)
@@ -231,12 +219,12 @@ fn frame_numbers(sequence: &SweepSequence) -> Vec<usize> {
     }
 }
 
-fn read_images(path: &Path, json: bool) -> Result<Input, Failure> {
-    let entries = std::fs::read_dir(path)
-        .map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))?;
+fn read_images(path: &Path) -> Result<Input, Failure> {
+    let entries =
+        std::fs::read_dir(path).map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
     let mut files = Vec::new();
     for entry in entries {
-        let entry = entry.map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))?;
+        let entry = entry.map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
         let file = entry.path();
         let image_ext = file
             .extension()
@@ -247,14 +235,11 @@ fn read_images(path: &Path, json: bool) -> Result<Input, Failure> {
         }
     }
     if files.is_empty() {
-        return Err(Failure::input(
-            format!(
-                "{}: neither a KITTI sequence (velodyne/*.bin), an NCLT session \
+        return Err(Failure::input(format!(
+            "{}: neither a KITTI sequence (velodyne/*.bin), an NCLT session \
                  (velodyne_sync/*.bin), a rosbag2 bag nor a folder of PNG/JPEG images",
-                path.display()
-            ),
-            json,
-        ));
+            path.display()
+        )));
     }
     files.sort_by(|a, b| a.file_name().cmp(&b.file_name()));
     let times: Option<Vec<f64>> = files.iter().map(|f| stamp_of(f)).collect();

@@ -54,26 +54,22 @@ pub fn ground_truth(
     source: &SourceArgs,
     input: &Input,
     params: &TruthParams,
-    json: bool,
 ) -> Result<(GroundTruth, Vec<Option<Pose3>>), Failure> {
-    let truth = read_truth(path, source, json)?;
+    let truth = read_truth(path, source)?;
     let paired = pair(&truth, input);
     if paired.iter().all(Option::is_none) {
-        return Err(Failure::input(
-            format!(
-                "{}: no pose pairs with a frame of {} ({} poses, {} frames{})",
-                path.display(),
-                input.path.display(),
-                truth.poses.len(),
-                input.total,
-                if truth.times.is_some() && input.times.is_some() {
-                    ", no common times"
-                } else {
-                    ", and no times to pair them by"
-                }
-            ),
-            json,
-        ));
+        return Err(Failure::input(format!(
+            "{}: no pose pairs with a frame of {} ({} poses, {} frames{})",
+            path.display(),
+            input.path.display(),
+            truth.poses.len(),
+            input.total,
+            if truth.times.is_some() && input.times.is_some() {
+                ", no common times"
+            } else {
+                ", and no times to pair them by"
+            }
+        )));
     }
     let times = input.times.as_deref();
     let built = if input.is_planar() {
@@ -93,25 +89,25 @@ pub fn ground_truth(
             .collect();
         GroundTruth::from_positions(&positions, times, params.radius_m, params.exclusion)
     };
-    let built = built.map_err(|e| Failure::input(format!("{}: {e}", path.display()), json))?;
+    let built = built.map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
     Ok((built, paired))
 }
 
 /// Reads a TUM or KITTI pose file, or else a bag or a CARMEN log (their reference poses and
 /// times).
-fn read_truth(path: &Path, source: &SourceArgs, json: bool) -> Result<TruthPoses, Failure> {
+fn read_truth(path: &Path, source: &SourceArgs) -> Result<TruthPoses, Failure> {
     if is_bag(path) {
-        return match source.open_bag(path).map_err(|e| Failure::input(e, json))? {
+        return match source.open_bag(path).map_err(Failure::input)? {
             BagSource::Planar(frames) => {
                 let frames = frames
                     .collect::<raypath_io::Result<Vec<_>>>()
-                    .map_err(|e| Failure::input(e, json))?;
-                planar_truth(path, &frames, json)
+                    .map_err(Failure::input)?;
+                planar_truth(path, &frames)
             }
             BagSource::Sweeps(sequence) => {
                 let poses = sequence
                     .require_reference()
-                    .map_err(|e| Failure::input(e, json))?
+                    .map_err(Failure::input)?
                     .to_vec();
                 Ok(TruthPoses {
                     poses,
@@ -134,32 +130,26 @@ fn read_truth(path: &Path, source: &SourceArgs, json: bool) -> Result<TruthPoses
         });
         match numbers {
             Some((true, 12, _)) => {
-                let poses =
-                    raypath_io::kitti::read_poses(path).map_err(|e| Failure::input(e, json))?;
+                let poses = raypath_io::kitti::read_poses(path).map_err(Failure::input)?;
                 return Ok(TruthPoses { poses, times: None });
             }
-            Some((true, 8, _)) => return read_tum(path, json),
+            Some((true, 8, _)) => return read_tum(path),
             Some((true, n, line)) => {
-                return Err(Failure::input(
-                    format!(
-                        "{}: line {line}: {n} numbers; expected 12 (KITTI poses) or 8 (TUM \
+                return Err(Failure::input(format!(
+                    "{}: line {line}: {n} numbers; expected 12 (KITTI poses) or 8 (TUM \
                          `t x y z qx qy qz qw`)",
-                        path.display()
-                    ),
-                    json,
-                ));
+                    path.display()
+                )));
             }
             _ => {}
         }
     }
-    let frames = source
-        .read_frames(path)
-        .map_err(|e| Failure::input(e, json))?;
-    planar_truth(path, &frames, json)
+    let frames = source.read_frames(path).map_err(Failure::input)?;
+    planar_truth(path, &frames)
 }
 
 /// The reference poses of planar frames and their times (frames without one are left out).
-fn planar_truth(path: &Path, frames: &[PlanarFrame], json: bool) -> Result<TruthPoses, Failure> {
+fn planar_truth(path: &Path, frames: &[PlanarFrame]) -> Result<TruthPoses, Failure> {
     let mut poses = Vec::new();
     let mut times = Vec::new();
     for (frame, pose) in frames.iter().zip(reference_track(frames)) {
@@ -169,14 +159,11 @@ fn planar_truth(path: &Path, frames: &[PlanarFrame], json: bool) -> Result<Truth
         }
     }
     if poses.is_empty() {
-        return Err(Failure::input(
-            format!(
-                "{}: no poses (neither a CARMEN log with laser scans, a bag, KITTI poses nor a \
+        return Err(Failure::input(format!(
+            "{}: no poses (neither a CARMEN log with laser scans, a bag, KITTI poses nor a \
                  TUM file)",
-                path.display()
-            ),
-            json,
-        ));
+            path.display()
+        )));
     }
     Ok(TruthPoses {
         poses,
@@ -185,8 +172,8 @@ fn planar_truth(path: &Path, frames: &[PlanarFrame], json: bool) -> Result<Truth
 }
 
 /// Reads a TUM file `t x y z qx qy qz qw` through `raypath_io::tum`.
-fn read_tum(path: &Path, json: bool) -> Result<TruthPoses, Failure> {
-    let stamped = raypath_io::tum::read_tum(path).map_err(|e| Failure::input(e, json))?;
+fn read_tum(path: &Path) -> Result<TruthPoses, Failure> {
+    let stamped = raypath_io::tum::read_tum(path).map_err(Failure::input)?;
     Ok(TruthPoses {
         poses: stamped.iter().map(|p| p.pose).collect(),
         times: Some(stamped.iter().map(|p| p.time_s).collect()),

@@ -18,13 +18,12 @@ pub fn mapping(
     track: &[Pose3],
     scans: &[usize],
     poles: &[Pole],
-    json: bool,
 ) -> Result<(), Failure> {
     let mut poses = Vec::new();
     let max_points = sweep_points(scans.len());
     for &i in scans {
         if let (Some(pose), Some(stamp)) = (track.get(i), drive.stamps_secs.get(i)) {
-            let cloud = drive.scan(i).map_err(|e| Failure::input(e, json))?;
+            let cloud = drive.scan(i).map_err(Failure::input)?;
             recording.sweep(*stamp, pose, &cloud, max_points)?;
             poses.push(*pose);
         }
@@ -43,13 +42,12 @@ pub fn localization(
     range: std::ops::Range<usize>,
     map: &[Pole],
     estimate: &PoseTrack<Pose2>,
-    json: bool,
 ) -> Result<(), Failure> {
     let start = drive.stamps_secs.get(range.start).copied().unwrap_or(0.0);
     recording.scene(topic::POLES, start, frame::MAP, &pole_entities(map, "pole"))?;
     let max_points = sweep_points(estimate.len());
     for (i, sample) in range.clone().zip(estimate.iter()) {
-        let cloud = drive.scan(i).map_err(|e| Failure::input(e, json))?;
+        let cloud = drive.scan(i).map_err(Failure::input)?;
         recording.sweep(
             sample.stamp_secs,
             &sample.pose.to_pose3(),
