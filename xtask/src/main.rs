@@ -3,6 +3,8 @@
 //! ```text
 //! cargo xtask eval <name>|all [--quick]   run evaluations, print tables, write docs/results/
 //! cargo xtask eval list                   list the evaluations
+//! cargo xtask eval <name> --shard i/n      run every n-th unit, write target/eval/shards/
+//! cargo xtask eval merge <name>            the report from the shards
 //! cargo xtask datasets                    what RAYPATH_DATA holds and what is missing
 //! cargo xtask datasets generate [--quick] [--only NAME] [--seed S]
 //!                                         write the simulated sets under datasets/generated/
@@ -39,11 +41,18 @@ enum Command {
     /// Run an evaluation (or `all`), print its table, write `docs/results/<name>.md` and
     /// `target/eval/<name>.json`.
     Eval {
-        /// Evaluation name, `all`, or `list`.
+        /// Evaluation name, `all`, `list`, or `merge` (then the evaluation to merge follows).
         name: String,
+        /// With `merge`: the evaluation whose shards to join.
+        merged: Option<String>,
         /// Smaller workloads (seconds instead of minutes); tables say so.
         #[arg(long)]
         quick: bool,
+        /// Run shard i of n (every n-th unit: log, sequence, session …) and write its results
+        /// to target/eval/shards/<name>/; `eval merge <name>` writes the report. For the
+        /// evaluations written in stages (an error names them).
+        #[arg(long, value_name = "I/N")]
+        shard: Option<eval::stages::Shard>,
     },
     /// List the data sets found under RAYPATH_DATA and the ones missing, with where to get them;
     /// `datasets generate` writes the simulated sets under datasets/generated/.
@@ -83,7 +92,18 @@ enum DatasetsAction {
 fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
-        Command::Eval { name, quick } => eval::run(&name, quick),
+        Command::Eval {
+            name,
+            merged,
+            quick,
+            shard,
+        } => match (name.as_str(), merged, shard) {
+            ("merge", Some(target), None) => eval::merge(&target, quick),
+            ("merge", None, _) => anyhow::bail!("eval merge <name>: name the evaluation"),
+            (_, None, Some(shard)) => eval::run_shard(&name, quick, shard),
+            (_, None, None) => eval::run(&name, quick),
+            (_, Some(extra), _) => anyhow::bail!("eval {name}: unexpected argument {extra:?}"),
+        },
         Command::Datasets { json, action } => match action {
             None => datasets::run(json),
             Some(DatasetsAction::Generate { quick, only, seed }) => {

@@ -23,6 +23,7 @@ use rayon::prelude::*;
 use raypath_io::carmen::{CarmenReader, FanConvention, Record};
 use serde_json::json;
 
+use super::stages::{self, Staged};
 use super::{EvalContext, EvalReport};
 use crate::render::TopDown;
 use crate::table::{Table, fmt_num};
@@ -87,7 +88,7 @@ struct Scan {
 }
 
 /// The sharpness of one rendering.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 struct Score {
     cells: usize,
     entropy_bits: f64,
@@ -216,6 +217,8 @@ fn sweep(scans: &[Scan]) -> ((i32, i32), usize, usize) {
     (grid[best], cells[best], cells[nominal])
 }
 
+/// One log's measurements: the result of one unit of the staged evaluation.
+#[derive(serde::Serialize, serde::Deserialize)]
 struct LogResult {
     sweep: ((i32, i32), usize, usize),
     log: String,
@@ -224,25 +227,101 @@ struct LogResult {
     hits: usize,
     scores: Vec<Score>,
     reader: Score,
+    /// Pictures written for this log: (caption, file under the figure directory).
+    pictures: Vec<(String, String)>,
 }
 
-/// Runs the evaluation.
+/// The evaluation in stages: one unit per corrected log (`--shard i/n` and `eval merge`).
+pub const STAGED: Staged = Staged {
+    name: "carmen-angles",
+    units,
+    run_unit,
+    report: report_units,
+};
+
+/// Runs the evaluation (every log, then the report).
 pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
-    let dir = ctx.data("carmen/corrected");
-    let mut logs: Vec<PathBuf> = std::fs::read_dir(&dir)
+    stages::run_all(&STAGED, ctx)
+}
+
+fn log_dir(ctx: &EvalContext) -> PathBuf {
+    ctx.data("carmen/corrected")
+}
+
+const SUFFIX: &str = "-corrected.log.gz";
+
+/// The corrected logs, by name, sorted.
+fn units(ctx: &EvalContext) -> Result<Vec<String>> {
+    let mut logs: Vec<String> = std::fs::read_dir(log_dir(ctx))
         .map(|entries| {
             entries
                 .flatten()
-                .map(|e| e.path())
-                .filter(|p| p.to_string_lossy().ends_with("-corrected.log.gz"))
+                .filter_map(|e| {
+                    let name = e.file_name().to_string_lossy().into_owned();
+                    name.strip_suffix(SUFFIX).map(str::to_owned)
+                })
                 .collect()
         })
         .unwrap_or_default();
     logs.sort();
-    if logs.is_empty() {
+    Ok(logs)
+}
+
+fn stride(ctx: &EvalContext) -> usize {
+    if ctx.quick { QUICK_STRIDE } else { 1 }
+}
+
+/// Scores one log under every candidate and draws its pictures.
+fn run_unit(ctx: &EvalContext, log: &str) -> Result<serde_json::Value> {
+    let path = log_dir(ctx).join(format!("{log}{SUFFIX}"));
+    let figures = ctx.figure_dir("carmen-angles")?;
+    let scans = load(&path, stride(ctx)).with_context(|| format!("reading {}", path.display()))?;
+    let beams = scans.first().map_or(0, |s| s.beams);
+    let hits = scans.iter().map(|s| s.hits.len()).sum();
+    let scores: Vec<Score> = CANDIDATES
+        .par_iter()
+        .map(|&c| score(&project(&scans, Some(c))))
+        .collect();
+    let reader = score(&project(&scans, None));
+    let sweep = sweep(&scans);
+    let mut pictures = Vec::new();
+    if PICTURED.contains(&log) {
+        let best = best_index(&scores);
+        let file = format!("{log}-{}.png", CANDIDATES[best].fan.name());
+        picture(
+            &project(&scans, Some(CANDIDATES[best])),
+            &figures.join(&file),
+        )?;
+        pictures.push((log.to_owned(), file));
+        if log == "intel" {
+            // The runner-up, for contrast.
+            let second = runner_up(&scores, best);
+            let file = format!("{log}-{}.png", CANDIDATES[second].fan.name());
+            picture(
+                &project(&scans, Some(CANDIDATES[second])),
+                &figures.join(&file),
+            )?;
+            pictures.push((format!("{log} (runner-up)"), file));
+        }
+    }
+    Ok(serde_json::to_value(LogResult {
+        sweep,
+        log: log.to_owned(),
+        beams,
+        scans: scans.len(),
+        hits,
+        scores,
+        reader,
+        pictures,
+    })?)
+}
+
+/// The page from every log's result.
+fn report_units(ctx: &EvalContext, units: &[(String, serde_json::Value)]) -> Result<EvalReport> {
+    if units.is_empty() {
         let message = format!(
             "No corrected CARMEN logs in `{}`: nothing to evaluate (set RAYPATH_DATA).\n",
-            dir.display()
+            log_dir(ctx).display()
         );
         eprintln!("{message}");
         return Ok(EvalReport {
@@ -253,58 +332,14 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             headline: None,
         });
     }
-    let stride = if ctx.quick { QUICK_STRIDE } else { 1 };
-    let figures = ctx.figure_dir("carmen-angles")?;
-    let bar = ctx.progress(logs.len() as u64, "rendering");
-    let mut results = Vec::new();
-    let mut pictures = Vec::new();
-    for path in &logs {
-        let log = path
-            .file_name()
-            .map(|n| n.to_string_lossy().replace("-corrected.log.gz", ""))
-            .unwrap_or_default();
-        bar.set_message(log.clone());
-        let scans = load(path, stride).with_context(|| format!("reading {}", path.display()))?;
-        let beams = scans.first().map_or(0, |s| s.beams);
-        let hits = scans.iter().map(|s| s.hits.len()).sum();
-        let scores: Vec<Score> = CANDIDATES
-            .par_iter()
-            .map(|&c| score(&project(&scans, Some(c))))
-            .collect();
-        let reader = score(&project(&scans, None));
-        let sweep = sweep(&scans);
-        if PICTURED.contains(&log.as_str()) {
-            let best = best_index(&scores);
-            let file = format!("{log}-{}.png", CANDIDATES[best].fan.name());
-            picture(
-                &project(&scans, Some(CANDIDATES[best])),
-                &figures.join(&file),
-            )?;
-            pictures.push((log.clone(), file));
-            if log == "intel" {
-                // The runner-up, for contrast.
-                let second = runner_up(&scores, best);
-                let file = format!("{log}-{}.png", CANDIDATES[second].fan.name());
-                picture(
-                    &project(&scans, Some(CANDIDATES[second])),
-                    &figures.join(&file),
-                )?;
-                pictures.push((format!("{log} (runner-up)"), file));
-            }
-        }
-        results.push(LogResult {
-            sweep,
-            log,
-            beams,
-            scans: scans.len(),
-            hits,
-            scores,
-            reader,
-        });
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
-    report(&results, &pictures, stride)
+    let results: Vec<LogResult> = units
+        .iter()
+        .map(|(log, value)| {
+            serde_json::from_value(value.clone()).with_context(|| format!("result of {log}"))
+        })
+        .collect::<Result<_>>()?;
+    let pictures: Vec<(String, String)> = results.iter().flat_map(|r| r.pictures.clone()).collect();
+    report(&results, &pictures, stride(ctx))
 }
 
 fn best_index(scores: &[Score]) -> usize {
@@ -576,6 +611,7 @@ mod tests {
                     cells: 100,
                     entropy_bits: 6.5,
                 },
+                pictures: vec![],
             },
             LogResult {
                 sweep: ((1, 0), 195, 200),
@@ -588,6 +624,7 @@ mod tests {
                     cells: 201,
                     entropy_bits: 7.25,
                 },
+                pictures: vec![],
             },
         ];
         let pictures = [("intel".to_owned(), "intel-half-open.png".to_owned())];
@@ -679,6 +716,7 @@ mod tests {
                 cells: 10,
                 entropy_bits: 3.0,
             },
+            pictures: vec![],
         }];
         let md = report(&results, &[], 1).unwrap().markdown;
         assert!(md.contains("Every scan of each corrected log"), "{md}");

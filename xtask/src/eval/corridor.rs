@@ -559,6 +559,7 @@ mod tests {
             workspace_root: crate::eval::workspace_root(),
             data_dir: std::path::PathBuf::from("datasets"),
             quick: std::env::var_os("CORRIDOR_FULL").is_none(),
+            out_dir: crate::eval::workspace_root(),
         };
         let (markdown, _) = section(&ctx).expect("section");
         println!("{markdown}");

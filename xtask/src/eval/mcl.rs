@@ -648,6 +648,7 @@ mod tests {
             workspace_root: crate::eval::workspace_root(),
             data_dir: std::env::temp_dir().join("raypath-mcl-test-absent-data"),
             quick: true,
+            out_dir: crate::eval::workspace_root(),
         };
         let mut cells = Vec::new();
         for (name, kind) in [("intel", "real"), ("indoor/office", "simulated")] {

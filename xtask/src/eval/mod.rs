@@ -24,6 +24,7 @@ mod sensor_models;
 mod sim;
 mod slam;
 mod slam_map;
+pub mod stages;
 mod synpeb;
 
 use std::path::{Path, PathBuf};
@@ -40,6 +41,10 @@ pub struct EvalContext {
     pub data_dir: PathBuf,
     /// Smaller workloads for CI and first runs.
     pub quick: bool,
+    /// Where the outputs go: `docs/results/`, `target/eval/` (and shards) under it. The
+    /// workspace root, or `RAYPATH_EVAL_OUT` when set (tests and cluster runs that must not
+    /// write into the checkout; the README's generated figures are then left alone).
+    pub out_dir: PathBuf,
 }
 
 impl EvalContext {
@@ -87,7 +92,7 @@ impl EvalContext {
     /// Where an evaluation may write pictures that belong to its report
     /// (`docs/results/<name>/`), created on demand.
     pub fn figure_dir(&self, name: &str) -> Result<PathBuf> {
-        let dir = self.workspace_root.join("docs/results").join(name);
+        let dir = self.out_dir.join("docs/results").join(name);
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
         Ok(dir)
     }
@@ -202,6 +207,55 @@ const EVALUATIONS: &[(&str, &str, EvalFn)] = &[
 ];
 
 /// Runs `name` (or `all`, or `list`).
+/// The evaluations written in stages: `--shard i/n` and `eval merge` work for these.
+const STAGED: &[&stages::Staged] = &[&carmen_angles::STAGED];
+
+fn staged(name: &str) -> Result<&'static stages::Staged> {
+    STAGED
+        .iter()
+        .copied()
+        .find(|s| s.name == name)
+        .with_context(|| {
+            let names: Vec<_> = STAGED.iter().map(|s| s.name).collect();
+            format!(
+                "{name:?} is not (yet) written in stages; --shard and merge work for: {}",
+                names.join(", ")
+            )
+        })
+}
+
+fn context(quick: bool) -> EvalContext {
+    let out_dir = match std::env::var_os("RAYPATH_EVAL_OUT") {
+        Some(dir) if !dir.is_empty() => PathBuf::from(dir),
+        _ => workspace_root(),
+    };
+    EvalContext {
+        workspace_root: workspace_root(),
+        data_dir: data_dir(),
+        quick,
+        out_dir,
+    }
+}
+
+/// `cargo xtask eval <name> --shard i/n`: the shard's units, written to
+/// `target/eval/shards/<name>/`.
+pub fn run_shard(name: &str, quick: bool, shard: stages::Shard) -> Result<()> {
+    let staged = staged(name)?;
+    let path = stages::run_shard(staged, &context(quick), shard)?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
+
+/// `cargo xtask eval merge <name>`: the report of the shards in `target/eval/shards/<name>/`,
+/// written as a single run writes it.
+pub fn merge(name: &str, quick: bool) -> Result<()> {
+    let staged = staged(name)?;
+    let ctx = context(quick);
+    let (results, seconds) = stages::merge(staged, &ctx, &stages::shard_dir(&ctx, name))?;
+    let report = (staged.report)(&ctx, &results)?;
+    write_report(&ctx, &report, seconds)
+}
+
 pub fn run(name: &str, quick: bool) -> Result<()> {
     if name == "list" {
         for (name, about, _) in EVALUATIONS {
@@ -209,11 +263,7 @@ pub fn run(name: &str, quick: bool) -> Result<()> {
         }
         return Ok(());
     }
-    let ctx = EvalContext {
-        workspace_root: workspace_root(),
-        data_dir: data_dir(),
-        quick,
-    };
+    let ctx = context(quick);
     let selected: Vec<_> = if name == "all" {
         EVALUATIONS.iter().collect()
     } else {
@@ -267,13 +317,13 @@ fn write_report(ctx: &EvalContext, report: &EvalReport, seconds: f64) -> Result<
     let markdown = format!("{header}{headline}{}", report.markdown.trim_end());
     println!("{markdown}\n");
 
-    let docs = ctx.workspace_root.join("docs/results");
+    let docs = ctx.out_dir.join("docs/results");
     std::fs::create_dir_all(&docs)?;
     let md_path = docs.join(format!("{}.md", report.name));
     std::fs::write(&md_path, format!("{markdown}\n"))
         .with_context(|| format!("writing {}", md_path.display()))?;
 
-    let json_dir = ctx.workspace_root.join("target/eval");
+    let json_dir = ctx.out_dir.join("target/eval");
     std::fs::create_dir_all(&json_dir)?;
     let json_path = json_dir.join(format!("{}.json", report.name));
     let json = serde_json::json!({
@@ -290,7 +340,11 @@ fn write_report(ctx: &EvalContext, report: &EvalReport, seconds: f64) -> Result<
     std::fs::write(&json_path, serde_json::to_string_pretty(&json)?)
         .with_context(|| format!("writing {}", json_path.display()))?;
     eprintln!("wrote {} and {}", md_path.display(), json_path.display());
-    if let (Some(text), false) = (&report.headline, ctx.quick) {
+    if let (Some(text), false, true) = (
+        &report.headline,
+        ctx.quick,
+        ctx.out_dir == ctx.workspace_root,
+    ) {
         crate::readme::update(&ctx.workspace_root, report.name, text)?;
     }
     Ok(())

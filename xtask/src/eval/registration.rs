@@ -470,6 +470,7 @@ mod tests {
             workspace_root: std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(".."),
             data_dir: std::env::temp_dir().join("raypath-registration-test-absent-data"),
             quick: true,
+            out_dir: crate::eval::workspace_root(),
         };
         let report = run(&ctx).unwrap();
         assert!(report.markdown.contains("| published (KISS-ICP)"));

@@ -372,8 +372,7 @@ fn unreferenced(ctx: &EvalContext, md: &mut String) -> Result<Vec<Value>> {
         "scans/s",
         "map",
     ]);
-    let dir = ctx.workspace_root.join("docs/results/slam");
-    std::fs::create_dir_all(&dir)?;
+    let dir = ctx.figure_dir("slam")?;
     let mut rows = Vec::new();
     for (name, raw) in logs {
         if !ctx.data(raw).exists() {

@@ -540,6 +540,7 @@ mod tests {
             workspace_root: crate::eval::workspace_root(),
             data_dir: std::env::temp_dir().join("raypath-dct-test-absent-data"),
             quick: true,
+            out_dir: crate::eval::workspace_root(),
         };
         let cells: Vec<Cell> = ["intel", "freiburg-campus", "aces"]
             .iter()

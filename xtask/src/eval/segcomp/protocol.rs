@@ -571,6 +571,7 @@ mod tests {
             workspace_root: std::env::temp_dir(),
             data_dir: std::env::temp_dir(),
             quick: true,
+            out_dir: std::env::temp_dir(),
         };
         let train = vec![image(Split::Train, 0)];
         let outcome = run(&ctx, "test", &train, 2, |i| Ok(image(Split::Test, i))).unwrap();
