@@ -25,6 +25,7 @@ use raypath_io::sequence::{SweepOptions, SweepSequence};
 use raypath_registration::{Odometry, OdometryConfig, RegistrationConfig, register};
 use serde_json::{Value, json};
 
+use super::stages::{self, Staged, UnitResults};
 use super::{EvalContext, EvalReport, comparable, median};
 use crate::table::{Table, fmt_num};
 
@@ -67,7 +68,7 @@ fn load(ctx: &EvalContext, name: &str, relative: &str, limit: usize) -> Result<O
 }
 
 /// Errors and costs of one method on one sequence.
-#[derive(Default)]
+#[derive(Default, serde::Serialize, serde::Deserialize)]
 struct Stats {
     rot_deg: Vec<f64>,
     trans_m: Vec<f64>,
@@ -75,8 +76,8 @@ struct Stats {
     iterations: Vec<f64>,
     millis: Vec<f64>,
     failures: Vec<String>,
-    /// Chained estimate and reference from the first to the last frame.
-    end: Option<(Pose3, Pose3)>,
+    /// Distance between the chained estimate and the reference at the last frame, metres.
+    end_error_m: Option<f64>,
 }
 
 impl Stats {
@@ -85,6 +86,11 @@ impl Stats {
         self.rot_deg.push(d.rotation().angle().to_degrees());
         self.trans_m.push(d.translation().norm());
         self.dist_m.push(truth.translation().norm());
+    }
+
+    /// The chained `estimate` and the `reference` from the first to the last frame.
+    fn end(&mut self, estimate: &Pose3, reference: &Pose3) {
+        self.end_error_m = Some((estimate.translation() - reference.translation()).norm());
     }
 
     fn mean(v: &[f64]) -> f64 {
@@ -106,9 +112,8 @@ impl Stats {
 
     /// End-point drift of the chained estimate over the path length, percent.
     fn drift_percent(&self) -> f64 {
-        self.end.map_or(f64::NAN, |(est, truth)| {
-            100.0 * (est.translation() - truth.translation()).norm()
-                / self.dist_m.iter().sum::<f64>()
+        self.end_error_m.map_or(f64::NAN, |error| {
+            100.0 * error / self.dist_m.iter().sum::<f64>()
         })
     }
 
@@ -188,7 +193,7 @@ fn frame_to_frame(seq: &Sequence, config: &RegistrationConfig) -> Stats {
         }
     }
     let last = seq.clouds.len() - 1;
-    stats.end = Some((chain, seq.truth[0].inverse() * seq.truth[last]));
+    stats.end(&chain, &(seq.truth[0].inverse() * seq.truth[last]));
     stats
 }
 
@@ -218,7 +223,7 @@ fn odometry(seq: &Sequence, config: &OdometryConfig, correct: bool) -> Result<St
         }
     }
     let (poses, last) = (odometry.poses(), seq.clouds.len() - 1);
-    stats.end = Some((poses[last], seq.truth[0].inverse() * seq.truth[last]));
+    stats.end(&poses[last], &(seq.truth[0].inverse() * seq.truth[last]));
     Ok(stats)
 }
 
@@ -303,8 +308,90 @@ const F2F: &str = "frame-to-frame ICP (identity guess)";
 const ODO: &str = "odometry, frame-to-map (constant velocity)";
 const ODO_CORR: &str = "odometry + 0.205° KITTI elevation correction";
 
+/// The evaluation in stages: one unit per KITTI sequence and one for the Ouster capture
+/// (`--shard i/n` and `eval merge`).
+pub const STAGED: Staged = Staged {
+    name: NAME,
+    units,
+    run_unit,
+    report,
+};
+
+/// Runs the evaluation (every sequence, then the report).
 pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
+    stages::run_all(&STAGED, ctx)
+}
+
+const OUSTER_UNIT: &str = "ouster";
+
+fn units(_: &EvalContext) -> Result<Vec<String>> {
+    Ok(KITTI
+        .iter()
+        .map(|s| format!("kitti-{s}"))
+        .chain([OUSTER_UNIT.to_owned()])
+        .collect())
+}
+
+/// One unit's result: whether its data was found, and each method's statistics.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct UnitResult {
+    present: bool,
+    runs: Vec<(String, Stats)>,
+}
+
+fn run_unit(ctx: &EvalContext, unit: &str) -> Result<Value> {
     let config = OdometryConfig::default();
+    let result = if let Some(seq) = unit.strip_prefix("kitti-") {
+        let name = format!("KITTI {seq}");
+        match load(ctx, &name, &format!("kitti/sequences/{seq}"), FRAMES)? {
+            Some(sequence) => {
+                eprintln!("{NAME}: {name} ({} frames)", sequence.clouds.len());
+                UnitResult {
+                    present: true,
+                    runs: vec![
+                        (F2F.into(), frame_to_frame(&sequence, &config.registration)),
+                        (ODO.into(), odometry(&sequence, &config, false)?),
+                        (ODO_CORR.into(), odometry(&sequence, &config, true)?),
+                    ],
+                }
+            }
+            None => UnitResult {
+                present: false,
+                runs: Vec::new(),
+            },
+        }
+    } else {
+        match load(ctx, "Ouster OS-1-128", OUSTER, usize::MAX)? {
+            Some(sequence) => {
+                eprintln!("{NAME}: Ouster ({} frames)", sequence.clouds.len());
+                UnitResult {
+                    present: true,
+                    runs: vec![
+                        (F2F.into(), frame_to_frame(&sequence, &config.registration)),
+                        (ODO.into(), odometry(&sequence, &config, false)?),
+                    ],
+                }
+            }
+            None => UnitResult {
+                present: false,
+                runs: Vec::new(),
+            },
+        }
+    };
+    Ok(serde_json::to_value(result)?)
+}
+
+/// The page from every unit's result.
+fn report(_: &EvalContext, results: &UnitResults) -> Result<EvalReport> {
+    let config = OdometryConfig::default();
+    let units: Vec<(&str, UnitResult)> = results
+        .iter()
+        .map(|(unit, value)| {
+            serde_json::from_value(value.clone())
+                .with_context(|| format!("result of {unit}"))
+                .map(|r| (unit.as_str(), r))
+        })
+        .collect::<Result<_>>()?;
     let mut table = Table::new(HEADERS);
     let mut totals: Vec<(&str, Stats)> = [F2F, ODO, ODO_CORR]
         .into_iter()
@@ -312,18 +399,15 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         .collect();
     let mut json_rows = Vec::new();
     let mut found = Vec::new();
-    for seq in KITTI {
-        let name = format!("KITTI {seq}");
-        let Some(sequence) = load(ctx, &name, &format!("kitti/sequences/{seq}"), FRAMES)? else {
+    for (unit, result) in &units {
+        let Some(seq) = unit.strip_prefix("kitti-") else {
             continue;
         };
-        eprintln!("{NAME}: {name} ({} frames)", sequence.clouds.len());
-        let runs = [
-            (F2F, frame_to_frame(&sequence, &config.registration)),
-            (ODO, odometry(&sequence, &config, false)?),
-            (ODO_CORR, odometry(&sequence, &config, true)?),
-        ];
-        for (method, stats) in &runs {
+        if !result.present {
+            continue;
+        }
+        let name = format!("KITTI {seq}");
+        for (method, stats) in &result.runs {
             table.row(stats.row("real", &name, method));
             json_rows.push(
                 json!({"data": "real", "sequence": name, "method": method, "stats": stats.json()}),
@@ -353,20 +437,15 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         }
     }
     table.row(PUBLISHED_ROW);
-    let ouster = match load(ctx, "Ouster OS-1-128", OUSTER, usize::MAX)? {
-        Some(sequence) => {
-            eprintln!("{NAME}: Ouster ({} frames)", sequence.clouds.len());
-            let runs = [
-                (F2F, frame_to_frame(&sequence, &config.registration)),
-                (ODO, odometry(&sequence, &config, false)?),
-            ];
-            for (method, stats) in &runs {
+    let ouster = match units.iter().find(|(unit, _)| *unit == OUSTER_UNIT) {
+        Some((_, result)) if result.present => {
+            for (method, stats) in &result.runs {
                 table.row(stats.row("real", "Ouster OS-1-128 lb_n3", method));
                 json_rows.push(json!({"data": "real", "sequence": "Ouster OS-1-128 lb_n3", "method": method, "stats": stats.json()}));
             }
             true
         }
-        None => {
+        _ => {
             table.row(absent_row("Ouster OS-1-128 lb_n3", OUSTER));
             false
         }
