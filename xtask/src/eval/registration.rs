@@ -341,43 +341,35 @@ struct UnitResult {
 
 fn run_unit(ctx: &EvalContext, unit: &str) -> Result<Value> {
     let config = OdometryConfig::default();
-    let result = if let Some(seq) = unit.strip_prefix("kitti-") {
-        let name = format!("KITTI {seq}");
-        match load(ctx, &name, &format!("kitti/sequences/{seq}"), FRAMES)? {
-            Some(sequence) => {
-                eprintln!("{NAME}: {name} ({} frames)", sequence.clouds.len());
-                UnitResult {
-                    present: true,
-                    runs: vec![
-                        (F2F.into(), frame_to_frame(&sequence, &config.registration)),
-                        (ODO.into(), odometry(&sequence, &config, false)?),
-                        (ODO_CORR.into(), odometry(&sequence, &config, true)?),
-                    ],
-                }
-            }
-            None => UnitResult {
-                present: false,
-                runs: Vec::new(),
-            },
+    // KITTI sequences also run the odometry with the elevation correction.
+    let (sequence, kitti) = match unit.strip_prefix("kitti-") {
+        Some(seq) => {
+            let name = format!("KITTI {seq}");
+            let relative = format!("kitti/sequences/{seq}");
+            (load(ctx, &name, &relative, FRAMES)?, true)
         }
-    } else {
-        match load(ctx, "Ouster OS-1-128", OUSTER, usize::MAX)? {
-            Some(sequence) => {
-                eprintln!("{NAME}: Ouster ({} frames)", sequence.clouds.len());
-                UnitResult {
-                    present: true,
-                    runs: vec![
-                        (F2F.into(), frame_to_frame(&sequence, &config.registration)),
-                        (ODO.into(), odometry(&sequence, &config, false)?),
-                    ],
-                }
-            }
-            None => UnitResult {
-                present: false,
-                runs: Vec::new(),
-            },
-        }
+        None => (load(ctx, "Ouster OS-1-128", OUSTER, usize::MAX)?, false),
     };
+    let mut result = UnitResult {
+        present: sequence.is_some(),
+        runs: Vec::new(),
+    };
+    if let Some(sequence) = sequence {
+        eprintln!(
+            "{NAME}: {} ({} frames)",
+            sequence.name,
+            sequence.clouds.len()
+        );
+        result.runs = vec![
+            (F2F.into(), frame_to_frame(&sequence, &config.registration)),
+            (ODO.into(), odometry(&sequence, &config, false)?),
+        ];
+        if kitti {
+            result
+                .runs
+                .push((ODO_CORR.into(), odometry(&sequence, &config, true)?));
+        }
+    }
     Ok(serde_json::to_value(result)?)
 }
 
