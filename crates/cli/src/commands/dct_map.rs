@@ -190,6 +190,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let fail = |e: raypath_dct_map::DctError| Failure::internal(e.to_string());
     let [xe, ye] = patch.extent_m;
     let truth = GroundTruth::new(patch.extent_m, TRUTH_CELL_M, &mapping).map_err(fail)?;
+    let spinner = super::console::spinner("fitting the DCT and grid maps");
     let (map, grid, c) = compare(
         patch.extent_m,
         shape,
@@ -199,6 +200,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         &FitConfig::default(),
     )
     .map_err(fail)?;
+    spinner.finish_and_clear();
     if let Some(out) = &args.out {
         write_map(out, &map)?;
     }

@@ -379,7 +379,11 @@ fn execute<R: PlaceRecognizer + Sync>(
 ) -> Result<Outcome, Failure> {
     let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()));
     let n = input.len();
-    let source = |i| input.frame(i);
+    let bar = super::console::progress(n, "place recognition");
+    let source = |i| {
+        bar.inc(1);
+        input.frame(i)
+    };
     match args.mode {
         Mode::Online => {
             let run =

@@ -169,7 +169,9 @@ fn build(args: &Args, recording: Option<&mut Recording>) -> Result<Report, Failu
     let config = check_args(args)?;
     let input =
         Input::read(&args.input, &args.source, args.ray_step, &config).map_err(Failure::input)?;
+    super::console::stage("reading", started);
     let mapping_started = Instant::now();
+    let spinner = super::console::spinner("mapping");
     let (stats, dims) = match &input {
         Input::Planar { scans, bounds, .. } => {
             let grid = raypath_geometry::Grid2::covering(bounds, args.resolution)
@@ -203,6 +205,8 @@ fn build(args: &Args, recording: Option<&mut Recording>) -> Result<Report, Failu
             (StoredStats::Spatial(stats), 3)
         }
     };
+    spinner.finish_and_clear();
+    super::console::stage("mapping", mapping_started);
     let mapping_secs = mapping_started.elapsed().as_secs_f64();
     let file = MapFile {
         kind: args.model.kind(),
