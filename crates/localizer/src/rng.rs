@@ -6,18 +6,18 @@
 //! result is the same whether rayon runs the particles on one thread or on many, in any order.
 //!
 //! The generator is xoshiro256++ (Blackman & Vigna, "Scrambled linear pseudorandom number
-//! generators", ACM TOMS 2021): 32 bytes of state, seeded in four SplitMix64 steps, a few
-//! nanoseconds per draw, and statistically sound for Monte-Carlo use (it is not a
-//! cryptographic generator). Seeding a ChaCha generator per particle would cost a keystream
-//! block (≈ 100 ns) per particle and step, which matters at 5000 particles and 50 Hz.
+//! generators", ACM TOMS 2021; `rand_xoshiro`'s implementation): 32 bytes of state, seeded
+//! in four SplitMix64 steps, a few nanoseconds per draw, and statistically sound for
+//! Monte-Carlo use (it is not a cryptographic generator). Seeding a ChaCha generator per
+//! particle would cost a keystream block (≈ 100 ns) per particle and step, which matters at
+//! 5000 particles and 50 Hz.
 
-use rand::RngCore;
+use rand::{RngCore, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
 
 /// The random generator handed to [`crate::MotionModel::sample`] and initializers.
 #[derive(Clone, Debug)]
-pub struct ParticleRng {
-    state: [u64; 4],
-}
+pub struct ParticleRng(Xoshiro256PlusPlus);
 
 /// Domains separate the uses of one operation number (a constant per use).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -31,20 +31,17 @@ pub(crate) enum Domain {
 }
 
 impl ParticleRng {
-    /// A generator seeded from a 64-bit value (expanded by SplitMix64).
+    /// A generator seeded from a 64-bit value: four state words `mix(seed + k·φ)`,
+    /// k = 1..4 (the expansion of earlier runs, kept so seeded results stay the same; it is
+    /// not `rand_xoshiro`'s own `seed_from_u64`).
     pub fn seed_from_u64(seed: u64) -> Self {
         let mut sm = seed;
-        let mut state = [0u64; 4];
-        for word in &mut state {
+        let mut bytes = [0u8; 32];
+        for word in bytes.chunks_exact_mut(8) {
             sm = sm.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            *word = mix(sm);
+            word.copy_from_slice(&mix(sm).to_le_bytes());
         }
-        // xoshiro's state must not be all zero; SplitMix64 outputs of four consecutive
-        // counters are never all zero, but guard anyway.
-        if state == [0; 4] {
-            state[0] = 1;
-        }
-        Self { state }
+        Self(Xoshiro256PlusPlus::from_seed(bytes))
     }
 
     /// The stream of item `index` (a particle) in operation `operation` under `seed`.
@@ -60,24 +57,15 @@ impl ParticleRng {
 
 impl RngCore for ParticleRng {
     fn next_u32(&mut self) -> u32 {
-        (self.next_u64() >> 32) as u32
+        self.0.next_u32()
     }
 
     fn next_u64(&mut self) -> u64 {
-        let [s0, s1, s2, s3] = self.state;
-        let result = s0.wrapping_add(s3).rotate_left(23).wrapping_add(s0);
-        let t = s1 << 17;
-        let mut s = [s0, s1, s2 ^ s0, s3 ^ s1];
-        s[1] ^= s[2];
-        s[0] ^= s[3];
-        s[2] ^= t;
-        s[3] = s[3].rotate_left(45);
-        self.state = s;
-        result
+        self.0.next_u64()
     }
 
     fn fill_bytes(&mut self, dst: &mut [u8]) {
-        rand::rand_core::impls::fill_bytes_via_next(self, dst);
+        self.0.fill_bytes(dst);
     }
 }
 
@@ -103,6 +91,32 @@ mod tests {
         let e: u64 = ParticleRng::stream(8, 1, 3).random();
         assert_eq!(a, b);
         assert!(a != c && a != d && a != e);
+    }
+
+    /// The generator of earlier runs (hand-written xoshiro256++ over SplitMix64 seeding):
+    /// `rand_xoshiro` gives the same numbers, so seeded results stay the same.
+    #[test]
+    fn same_numbers_as_the_reference_xoshiro256plusplus() {
+        for seed in [0u64, 7, 2020, u64::MAX] {
+            let mut sm = seed;
+            let mut s = [0u64; 4];
+            for word in &mut s {
+                sm = sm.wrapping_add(0x9E37_79B9_7F4A_7C15);
+                *word = mix(sm);
+            }
+            let mut rng = ParticleRng::seed_from_u64(seed);
+            for _ in 0..1000 {
+                let expected = s[0].wrapping_add(s[3]).rotate_left(23).wrapping_add(s[0]);
+                let t = s[1] << 17;
+                s[2] ^= s[0];
+                s[3] ^= s[1];
+                s[1] ^= s[2];
+                s[0] ^= s[3];
+                s[2] ^= t;
+                s[3] = s[3].rotate_left(45);
+                assert_eq!(rng.next_u64(), expected, "seed {seed}");
+            }
+        }
     }
 
     #[test]

@@ -29,15 +29,17 @@ use raypath_sensor_models::{
     Tabulated,
 };
 
-/// SplitMix64.
-struct Rng(u64);
+/// Uniform numbers in `[0, 1)` from SplitMix64 (53 bits).
+struct Rng(rand_xoshiro::SplitMix64);
 impl Rng {
+    fn new(state: u64) -> Self {
+        use rand_xoshiro::rand_core::SeedableRng;
+        Self(rand_xoshiro::SplitMix64::seed_from_u64(state))
+    }
+
     fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        use rand_xoshiro::rand_core::RngCore;
+        (self.0.next_u64() >> 11) as f64 / (1u64 << 53) as f64
     }
 }
 
@@ -60,7 +62,7 @@ fn scans_2d() -> (&'static str, Vec<(Pose2, Scan2)>) {
 
 /// A 40 m square room with a 4 × 4 lattice of 1 m round pillars, scanned by 180 beams.
 fn synthetic_room() -> Vec<(Pose2, Scan2)> {
-    let mut rng = Rng(7);
+    let mut rng = Rng::new(7);
     let pillars: Vec<Point2<f64>> = (0..16)
         .map(|i| Point2::new(-15.0 + 10.0 * (i % 4) as f64, -15.0 + 10.0 * (i / 4) as f64))
         .collect();
@@ -328,7 +330,7 @@ fn likelihood_2d(c: &mut Criterion) {
 /// Synthetic sweeps: rays from poses on a 30 m circle, elevations −24.8° to +2°, ranges
 /// 5–40 m, 5 % no-returns.
 fn sweeps_3d(count: usize, rays: usize, seed: u64) -> Vec<Vec<Ray3>> {
-    let mut rng = Rng(seed);
+    let mut rng = Rng::new(seed);
     (0..count)
         .map(|s| {
             let phase = s as f64 / count as f64 * std::f64::consts::TAU;

@@ -16,21 +16,23 @@ use nalgebra::{Point2, Point3, Vector3};
 use raypath_geometry::{Grid2, Grid3, Range, Ray2, Ray3};
 use raypath_sensor_models::{DenseStats2, DenseStats3, MappingConfig, SensorRange, SparseStats3};
 
-/// SplitMix64.
-struct Rng(u64);
+/// Uniform numbers in `[0, 1)` from SplitMix64 (53 bits).
+struct Rng(rand_xoshiro::SplitMix64);
 impl Rng {
+    fn new(state: u64) -> Self {
+        use rand_xoshiro::rand_core::SeedableRng;
+        Self(rand_xoshiro::SplitMix64::seed_from_u64(state))
+    }
+
     fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        use rand_xoshiro::rand_core::RngCore;
+        (self.0.next_u64() >> 11) as f64 / (1u64 << 53) as f64
     }
 }
 
 /// Scans of rays in the map frame.
 fn scans_3d() -> Vec<Vec<Ray3>> {
-    let mut rng = Rng(2020);
+    let mut rng = Rng::new(2020);
     (0..48)
         .map(|s| {
             let phase = s as f64 / 48.0 * std::f64::consts::TAU;
@@ -57,7 +59,7 @@ fn scans_3d() -> Vec<Vec<Ray3>> {
 }
 
 fn scans_2d() -> Vec<Vec<Ray2>> {
-    let mut rng = Rng(2017);
+    let mut rng = Rng::new(2017);
     (0..2000)
         .map(|s| {
             let phase = s as f64 / 2000.0 * std::f64::consts::TAU;

@@ -85,9 +85,9 @@ pub fn fnv1a(text: &str) -> u64 {
 
 /// The generator of case `case` of `reader` in a run seeded with `seed`.
 pub fn case_rng(seed: u64, reader: &str, case: u64) -> SplitMix64 {
-    let mut mix = SplitMix64(seed ^ fnv1a(reader).rotate_left(29));
+    let mut mix = SplitMix64::new(seed ^ fnv1a(reader).rotate_left(29));
     let base = mix.next_u64();
-    let mut rng = SplitMix64(base ^ case.wrapping_mul(0xD6E8_FEB8_6659_FD93));
+    let mut rng = SplitMix64::new(base ^ case.wrapping_mul(0xD6E8_FEB8_6659_FD93));
     rng.next_u64();
     rng
 }

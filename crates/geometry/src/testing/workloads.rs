@@ -14,18 +14,22 @@ use nalgebra::{Point2, Point3, Vector2, Vector3};
 
 use crate::{Grid2, Grid3, Range, Ray2, Ray3};
 
-/// SplitMix64: a tiny, fast, seeded generator (Steele, Lea & Flood 2014).
+/// The workloads' generator: SplitMix64 (Steele, Lea & Flood 2014, from `rand_xoshiro`)
+/// started at the given state, with the two draws the workloads need.
 #[derive(Clone, Debug)]
-pub struct SplitMix64(pub u64);
+pub struct SplitMix64(rand_xoshiro::SplitMix64);
 
 impl SplitMix64 {
+    /// The generator at state `state`.
+    pub fn new(state: u64) -> Self {
+        use rand_xoshiro::rand_core::SeedableRng;
+        Self(rand_xoshiro::SplitMix64::seed_from_u64(state))
+    }
+
     /// The next 64 random bits.
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        use rand_xoshiro::rand_core::RngCore;
+        self.0.next_u64()
     }
 
     /// Uniform in `[lo, hi)`.
@@ -64,7 +68,7 @@ fn hit_or_no_return(rng: &mut SplitMix64, max_hit_m: f64) -> Range {
 
 /// `n` rays starting inside [`grid3`] (max range 30 m).
 pub fn rays_inside_3d(n: usize, seed: u64) -> Vec<Ray3> {
-    let mut rng = SplitMix64(seed);
+    let mut rng = SplitMix64::new(seed);
     let mut rays = Vec::with_capacity(n);
     while rays.len() < n {
         let origin = Point3::new(
@@ -80,7 +84,7 @@ pub fn rays_inside_3d(n: usize, seed: u64) -> Vec<Ray3> {
 
 /// `n` no-return rays from a 25 m sphere through [`grid3`] (max range 60 m).
 pub fn rays_outside_3d(n: usize, seed: u64) -> Vec<Ray3> {
-    let mut rng = SplitMix64(seed);
+    let mut rng = SplitMix64::new(seed);
     let mut rays = Vec::with_capacity(n);
     while rays.len() < n {
         let origin = Point3::from(rng.unit3() * 25.0);
@@ -96,7 +100,7 @@ pub fn rays_outside_3d(n: usize, seed: u64) -> Vec<Ray3> {
 
 /// `n` rays starting in the central 100 m square of [`grid2`] (max range 50 m).
 pub fn rays_inside_2d(n: usize, seed: u64) -> Vec<Ray2> {
-    let mut rng = SplitMix64(seed);
+    let mut rng = SplitMix64::new(seed);
     let mut rays = Vec::with_capacity(n);
     while rays.len() < n {
         let origin = Point2::new(rng.uniform(-50.0, 50.0), rng.uniform(-50.0, 50.0));

@@ -31,7 +31,6 @@ use std::path::Path;
 use nalgebra::{Point2, Point3};
 use raypath_geometry::{Grid2, Grid3};
 
-use crate::export::crc::crc32;
 use crate::stats::{CellStats, DenseStats2, DenseStats3, MappingConfig, MappingSummary};
 use crate::{SensorModelError, SensorRange};
 
@@ -159,7 +158,7 @@ impl MapFile {
         for c in cells {
             out.extend_from_slice(&c.path_length_m().to_le_bytes());
         }
-        let crc = crc32(&out);
+        let crc = crc32fast::hash(&out);
         out.extend_from_slice(&crc.to_le_bytes());
         out
     }
@@ -275,7 +274,7 @@ impl MapFile {
                 .and_then(|b| b.try_into().ok())
                 .ok_or_else(|| r.error_at(body_end as u64, "missing checksum".into()))?,
         );
-        if crc32(bytes.get(..body_end).unwrap_or_default()) != stored_crc {
+        if crc32fast::hash(bytes.get(..body_end).unwrap_or_default()) != stored_crc {
             return Err(r.error_at(body_end as u64, "checksum mismatch (file corrupted)".into()));
         }
         let n = n as usize;

@@ -1,7 +1,6 @@
 //! Map export: ROS `map_server` PGM + YAML, PNG pictures, and the binary map format.
 
 mod binary;
-mod crc;
 mod ros_map;
 
 pub use binary::{MapFile, MapKind, StoredStats};

@@ -3,7 +3,6 @@
 mod cell;
 mod config;
 mod dense;
-mod hasher;
 pub(crate) mod insert;
 mod parallel;
 mod sparse;

@@ -7,10 +7,10 @@ use raypath_geometry::{PointCloud, Pose3};
 use crate::SensorModelError;
 use crate::dimension::{Crossing, Dimension, Planar, Spatial};
 use crate::stats::dense::for_each_cloud_ray;
-use crate::stats::hasher::BuildKeyHasher;
 use crate::stats::insert::{StatsSink, insert_ray};
 use crate::stats::parallel::insert_parallel;
 use crate::stats::{CellStats, DenseStats, MappingConfig, MappingSummary};
+use rustc_hash::FxBuildHasher;
 
 /// Edge of a block in cells.
 pub const BLOCK_EDGE: usize = 8;
@@ -29,7 +29,7 @@ pub struct SparseStats<D: Dimension> {
     grid: D::Grid,
     /// Blocks per axis (padded to three axes).
     blocks_per_axis: [usize; 3],
-    index: HashMap<u64, usize, BuildKeyHasher>,
+    index: HashMap<u64, usize, FxBuildHasher>,
     blocks: Vec<Box<[CellStats]>>,
     keys: Vec<u64>,
     /// The last block used: (key, position in `blocks`).
