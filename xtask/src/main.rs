@@ -49,7 +49,7 @@ enum Command {
         #[arg(long)]
         quick: bool,
         /// Run shard i of n (every n-th unit: log, sequence, session …) and write its results
-        /// to target/eval/shards/<name>/; `eval merge <name>` writes the report. For the
+        /// to `target/eval/shards/<name>/`; `eval merge <name>` writes the report. For the
         /// evaluations written in stages (an error names them).
         #[arg(long, value_name = "I/N")]
         shard: Option<eval::stages::Shard>,

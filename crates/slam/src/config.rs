@@ -161,7 +161,7 @@ pub struct SlamConfig {
     /// Optimise the pose graph after this many new nodes when new loop constraints have come
     /// in; once more at the end. Default 50.
     pub optimize_every_nodes: usize,
-    /// Loop edges whose robust weight ([`PoseGraph::edge_weight`](crate::PoseGraph::edge_weight))
+    /// Loop edges whose robust weight ([`PoseGraph::edge_weight`](crate::graph::PoseGraph::edge_weight))
     /// ends below this at the final optimisation are rejected: switched off, and the graph
     /// optimised once more without them. Default 0.5 (ours): on the Intel, Freiburg 079
     /// and MIT CSAIL raw logs every loop closure that the map of the corrected log refutes
