@@ -348,6 +348,19 @@ impl LoopCheck {
     }
 }
 
+/// How many of `checks` are wrong at a disputed reference
+/// ([`LoopCheck::reference_disputed`]).
+pub fn wrong_at_disputed_reference(
+    checks: &[LoopCheck],
+    scans: &[&raypath_geometry::Scan2],
+    reference: &[Option<Pose2>],
+) -> usize {
+    checks
+        .iter()
+        .filter(|c| c.is_wrong() && c.reference_disputed(scans, reference))
+        .count()
+}
+
 /// Scans closer than this (by index) to the scan under test are left out of the map that
 /// [`reference_support`] checks it against: 30, a few metres of travel in the logs we read.
 pub const DISPUTE_GAP: usize = 30;

@@ -157,10 +157,7 @@ fn score(
         let checks;
         (checked, wrong, checks) = check_loops(out, truth, 50);
         let scans: Vec<&raypath_geometry::Scan2> = frames.iter().map(|f| &f.scan).collect();
-        disputed = checks
-            .iter()
-            .filter(|c| c.is_wrong() && c.reference_disputed(&scans, truth))
-            .count();
+        disputed = raypath_slam::benchmark::wrong_at_disputed_reference(&checks, &scans, truth);
     }
     Scored {
         consecutive,

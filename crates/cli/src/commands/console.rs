@@ -75,7 +75,6 @@ pub fn stage(stage: &str, started: Instant) {
 /// that runs to the end); hidden like [`progress`]. Finish it with `finish_and_clear`.
 pub fn spinner(what: &str) -> ProgressBar {
     let bar = progress(0, what);
-    bar.set_length(0);
     if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} ({elapsed})") {
         bar.set_style(style);
     }

@@ -280,10 +280,7 @@ fn evaluate(
     );
     let (checked, wrong, checks) = check_loops(out, &truth, NEIGHBOUR_GAP);
     let scans: Vec<_> = frames.iter().map(|f| &f.scan).collect();
-    let disputed = checks
-        .iter()
-        .filter(|c| c.is_wrong() && c.reference_disputed(&scans, &truth))
-        .count();
+    let disputed = raypath_slam::benchmark::wrong_at_disputed_reference(&checks, &scans, &truth);
     Ok(json!({
         "paired_scans": paired,
         "summary": summary,
