@@ -163,9 +163,9 @@ pub struct SlamConfig {
     pub optimize_every_nodes: usize,
     /// Loop edges whose robust weight ([`PoseGraph::edge_weight`](crate::graph::PoseGraph::edge_weight))
     /// ends below this at the final optimisation are rejected: switched off, and the graph
-    /// optimised once more without them. Default 0.5 (ours): on the Intel, Freiburg 079
-    /// and MIT CSAIL raw logs every loop closure that the map of the corrected log refutes
-    /// ended with a weight of 0.21–0.44, and 2 of about 1 400 right ones below 0.5.
+    /// optimised once more without them. Default 0.5 (ours): on the raw benchmark logs the
+    /// loop closures that the corrected log's own map refutes end well below it, right ones
+    /// almost never (the wrong-loop counts are in `docs/results/slam.md`).
     pub reject_weight: f64,
 }
 
