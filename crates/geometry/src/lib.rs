@@ -68,5 +68,6 @@ pub use range_image::{
 pub use ray::{Range, Ray2, Ray3};
 pub use scan2::Scan2;
 pub use traversal::{
-    CellCrossing, CellCrossing2, CellCrossing3, Traversal, Traversal2, Traversal3,
+    CellCrossing, CellCrossing2, CellCrossing3, SlabWalk, SlabWalkEnd, Traversal, Traversal2,
+    Traversal3,
 };

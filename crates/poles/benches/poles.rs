@@ -121,8 +121,10 @@ fn bench_localize(c: &mut Criterion) {
     group.throughput(Throughput::Elements(1));
     group.bench_function("predict_update_5000_particles_15_poles", |b| {
         b.iter(|| {
-            filter.predict(&Pose2::new(0.0, 0.0, 0.0), [0.01, 0.01, 0.001]);
-            filter.update(&online);
+            filter
+                .predict(&Pose2::new(0.0, 0.0, 0.0), [0.01, 0.01, 0.001])
+                .expect("predict");
+            filter.update(&online).expect("update");
             filter.estimate()
         })
     });

@@ -4,8 +4,11 @@
 //! A voxel with `h` hits and `m` misses has the reflection-rate posterior
 //! `Beta(h + α, m + β)`; its occupancy is the posterior mass above the threshold `μ_o`,
 //! `o = 1 − I_{μ_o}(h + α, m + β)` with the regularized incomplete beta function `I`. The prior
-//! `Beta(α, β)` is fitted by the method of moments to the maximum-likelihood reflection rates
-//! `h / (h + m)` of the observed voxels.
+//! `Beta(α, β)` ([`BetaPrior`] of `raypath-sensor-models`) is fitted by the method of moments
+//! ([`MomentStatistics`]) to the maximum-likelihood reflection rates `h / (h + m)` of the
+//! observed voxels.
+
+use raypath_sensor_models::{BetaPrior, MomentStatistics};
 
 /// The regularized incomplete beta function `I_x(a, b)` for `a, b > 0`, `x ∈ [0, 1]` (from
 /// `statrs`; `x` outside `[0, 1]` is clamped, invalid shapes give NaN).
@@ -13,76 +16,40 @@ fn regularized_incomplete_beta(x: f64, a: f64, b: f64) -> f64 {
     statrs::function::beta::checked_beta_reg(a, b, x.clamp(0.0, 1.0)).unwrap_or(f64::NAN)
 }
 
-/// The prior `Beta(α, β)` of the reflection rates, fitted by the method of moments.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ReflectionPrior {
-    /// α > 0.
-    pub alpha: f64,
-    /// β > 0.
-    pub beta: f64,
+/// Smallest concentration `α + β` accepted from the moments (a guard the thesis does not
+/// need: a (nearly) binary maximum-likelihood map makes the moment estimate degenerate, with
+/// `α, β → 0` or negative; see [`BetaPrior::from_moments_clamped`]).
+pub(crate) const MIN_CONCENTRATION: f64 = 1e-3;
+
+/// The prior `Beta(α, β)` of the reflection rates, fitted by the method of moments to the
+/// maximum-likelihood rates `h / (h + m)` of the voxels with `h + m > 0` (Schaefer 2020,
+/// §12.4.1; degenerate moments clamped, [`MIN_CONCENTRATION`]).
+pub(crate) fn reflection_prior(hits: &[u16], misses: &[u16]) -> BetaPrior {
+    let rates = hits.iter().zip(misses).filter_map(|(&h, &m)| {
+        let total = h as u32 + m as u32;
+        (total > 0).then(|| h as f64 / total as f64)
+    });
+    let moments = MomentStatistics::of(rates).unwrap_or(MomentStatistics {
+        cells: 0,
+        mean: f64::NAN,
+        variance: f64::NAN,
+    });
+    BetaPrior::from_moments_clamped(&moments, MIN_CONCENTRATION)
 }
 
-impl ReflectionPrior {
-    /// Smallest concentration `α + β` accepted from the moments (a guard the thesis does not
-    /// need: a (nearly) binary maximum-likelihood map makes the moment estimate degenerate,
-    /// with `α, β → 0` or negative).
-    pub const MIN_CONCENTRATION: f64 = 1e-3;
-
-    /// Fits the prior to the mean `γ` and variance `δ` of the maximum-likelihood reflection
-    /// rates: `α = γc`, `β = (1 − γ)c` with `c = γ(1 − γ)/δ − 1` (Schaefer 2020, §12.4.1,
-    /// the method of moments). Degenerate moments (no data, `δ = 0`, `c` below
-    /// [`Self::MIN_CONCENTRATION`]) are clamped; the mean is clamped to `[1e-6, 1 − 1e-6]`.
-    pub fn from_moments(mean: f64, variance: f64) -> Self {
-        let gamma = if mean.is_finite() {
-            mean.clamp(1e-6, 1.0 - 1e-6)
-        } else {
-            0.5
-        };
-        let c = gamma * (1.0 - gamma) / variance - 1.0; // Eq. (12.x): α = −γ(γ² − γ + δ)/δ
-        let c = if c.is_finite() {
-            c.max(Self::MIN_CONCENTRATION)
-        } else {
-            Self::MIN_CONCENTRATION
-        };
-        Self {
-            alpha: gamma * c,
-            beta: (1.0 - gamma) * c,
-        }
-    }
-
-    /// Fits the prior to hit/miss counts (voxels with `h + m > 0` only).
-    pub fn estimate(hits: &[u16], misses: &[u16]) -> Self {
-        let (mut n, mut sum, mut sum_sq) = (0u64, 0.0f64, 0.0f64);
-        for (&h, &m) in hits.iter().zip(misses) {
-            let total = h as u64 + m as u64;
-            if total > 0 {
-                let r = h as f64 / total as f64;
-                n += 1;
-                sum += r;
-                sum_sq += r * r;
-            }
-        }
-        if n == 0 {
-            return Self::from_moments(f64::NAN, f64::NAN);
-        }
-        let mean = sum / n as f64;
-        let variance = (sum_sq / n as f64 - mean * mean).max(0.0);
-        Self::from_moments(mean, variance)
-    }
-
-    /// The occupancy `1 − I_{μ_o}(h + α, m + β)` of a voxel with `hits` and `misses`.
-    pub fn occupancy(&self, hits: u32, misses: u32, threshold: f64) -> f64 {
-        1.0 - regularized_incomplete_beta(
-            threshold,
-            hits as f64 + self.alpha,
-            misses as f64 + self.beta,
-        )
-    }
+/// The occupancy `1 − I_{μ_o}(h + α, m + β)` of a voxel with `hits` and `misses` under
+/// `prior`: the posterior probability that its reflection rate exceeds `threshold`.
+pub(crate) fn occupancy_of(prior: &BetaPrior, hits: u32, misses: u32, threshold: f64) -> f64 {
+    1.0 - regularized_incomplete_beta(
+        threshold,
+        hits as f64 + prior.alpha,
+        misses as f64 + prior.beta,
+    )
 }
 
 /// Occupancies of small counts, computed once per map (most voxels share a few `(h, m)`).
 pub(crate) struct OccupancyTable {
-    prior: ReflectionPrior,
+    prior: BetaPrior,
     threshold: f64,
     table: Vec<f32>,
 }
@@ -92,7 +59,7 @@ const TABLE_HITS: usize = 16;
 const TABLE_MISSES: usize = 512;
 
 impl OccupancyTable {
-    pub(crate) fn new(prior: ReflectionPrior, threshold: f64) -> Self {
+    pub(crate) fn new(prior: BetaPrior, threshold: f64) -> Self {
         Self {
             prior,
             threshold,
@@ -110,14 +77,14 @@ impl OccupancyTable {
                 if !v.is_nan() {
                     return v;
                 }
-                let v = self.prior.occupancy(hits, misses, self.threshold) as f32;
+                let v = occupancy_of(&self.prior, hits, misses, self.threshold) as f32;
                 if let Some(s) = self.table.get_mut(slot) {
                     *s = v;
                 }
                 return v;
             }
         }
-        self.prior.occupancy(hits, misses, self.threshold) as f32
+        occupancy_of(&self.prior, hits, misses, self.threshold) as f32
     }
 }
 
@@ -143,18 +110,35 @@ mod tests {
     #[test]
     fn method_of_moments_recovers_the_prior() {
         // Beta(2, 6): mean 0.25, variance ab/((a+b)²(a+b+1)) = 12/(64·9).
-        let prior = ReflectionPrior::from_moments(0.25, 12.0 / 576.0);
+        let moments = MomentStatistics {
+            cells: 8,
+            mean: 0.25,
+            variance: 12.0 / 576.0,
+        };
+        let prior = BetaPrior::from_moments_clamped(&moments, MIN_CONCENTRATION);
         assert!((prior.alpha - 2.0).abs() < 1e-9 && (prior.beta - 6.0).abs() < 1e-9);
         // Degenerate (binary) data stays valid.
-        let binary = ReflectionPrior::estimate(&[1, 0, 1, 0], &[0, 3, 0, 2]);
+        let binary = reflection_prior(&[1, 0, 1, 0], &[0, 3, 0, 2]);
         assert!(binary.alpha > 0.0 && binary.beta > 0.0);
+        assert!((binary.alpha + binary.beta - MIN_CONCENTRATION).abs() < 1e-15);
+        // Counts: rates 1/4, 3/4, 1/2 (the unobserved voxel left out): mean 1/2, variance
+        // 1/24, so α + β = (1/4)/(1/24) − 1 = 5.
+        let prior = reflection_prior(&[1, 3, 2, 0], &[3, 1, 2, 0]);
+        assert!((prior.alpha - 2.5).abs() < 1e-9 && (prior.beta - 2.5).abs() < 1e-9);
     }
 
     #[test]
     fn occupancy_grows_with_hits() {
-        let prior = ReflectionPrior::from_moments(0.1, 0.02);
-        let free = prior.occupancy(0, 10, 0.2);
-        let hit = prior.occupancy(5, 1, 0.2);
+        let prior = BetaPrior::from_moments_clamped(
+            &MomentStatistics {
+                cells: 10,
+                mean: 0.1,
+                variance: 0.02,
+            },
+            MIN_CONCENTRATION,
+        );
+        let free = occupancy_of(&prior, 0, 10, 0.2);
+        let hit = occupancy_of(&prior, 5, 1, 0.2);
         assert!(free < 0.05 && hit > 0.95, "free {free}, hit {hit}");
     }
 }

@@ -13,16 +13,6 @@ pub enum PoleError {
         /// Why it is invalid.
         reason: String,
     },
-    /// A pole-map file is malformed.
-    #[error("{}:{line}: {reason}", path.display())]
-    Malformed {
-        /// The file.
-        path: PathBuf,
-        /// One-based line number.
-        line: u64,
-        /// What is wrong.
-        reason: String,
-    },
     /// Reading a sequence failed (the error names the file and the place).
     #[error(transparent)]
     Read(#[from] raypath_io::Error),
@@ -34,17 +24,9 @@ pub enum PoleError {
         /// What is missing.
         reason: String,
     },
-    /// Trajectory evaluation failed.
+    /// The localizer failed: a particle-filter step or the trajectory evaluation.
     #[error(transparent)]
-    Evaluation(#[from] raypath_localizer::LocalizerError),
-    /// Reading or writing a file failed.
-    #[error("{}: {source}", path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The I/O error.
-        source: std::io::Error,
-    },
+    Localizer(#[from] raypath_localizer::LocalizerError),
 }
 
 /// The result type of the crate.

@@ -7,8 +7,9 @@ use std::time::Instant;
 use nalgebra::Point3;
 use rayon::prelude::*;
 use raypath_geometry::{Grid3, PointCloud, Pose3};
+use raypath_sensor_models::BetaPrior;
 
-use crate::beta::{OccupancyTable, ReflectionPrior};
+use crate::beta::{OccupancyTable, reflection_prior};
 use crate::error::{PoleError, Result};
 use crate::filters::{Scratch, rect_max};
 use crate::hitmiss::HitMissGrid;
@@ -72,9 +73,10 @@ pub fn extract_poles_from_sweeps(
 }
 
 /// The occupancy `1 − I_{μ_o}(h + α, m + β)` of every voxel (Schaefer 2020, §12.4.1) with the
-/// prior fitted to the counts by the method of moments.
-pub fn occupancy(counts: &HitMissGrid, threshold: f64) -> (Vec<f32>, ReflectionPrior) {
-    let prior = ReflectionPrior::estimate(counts.hits(), counts.misses());
+/// prior fitted to the counts by the method of moments (degenerate moments clamped to a
+/// concentration `α + β ≥ 10⁻³`, [`BetaPrior::from_moments_clamped`]).
+pub fn occupancy(counts: &HitMissGrid, threshold: f64) -> (Vec<f32>, BetaPrior) {
+    let prior = reflection_prior(counts.hits(), counts.misses());
     let mut occ = vec![0.0f32; counts.hits().len()];
     occ.par_chunks_mut(1 << 15)
         .zip(counts.hits().par_chunks(1 << 15))

@@ -99,7 +99,8 @@ impl LabelledLocalMap {
             path: dir.to_path_buf(),
             reason,
         };
-        let all_motions = SweepMotion::from_poses(poses, &drive.stamps_secs, SweepTiming::kitti());
+        let all_motions =
+            SweepMotion::from_poses(poses, &drive.sweeps.stamps_secs, SweepTiming::kitti());
         let mut scans = Vec::with_capacity(range.len());
         let mut motions = Vec::with_capacity(range.len());
         for i in range {
@@ -110,7 +111,7 @@ impl LabelledLocalMap {
             let labels = sequence
                 .labels(file.frame)?
                 .ok_or_else(|| missing(format!("no labels for frame {}", file.frame)))?;
-            let mut cloud = drive.scan(i)?;
+            let mut cloud = drive.sweeps.sweep(i)?;
             cloud.label = Some(labels.iter().map(|l| l.raw()).collect());
             let pose = poses
                 .get(i)

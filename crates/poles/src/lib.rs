@@ -9,13 +9,14 @@
 //!
 //! A pole is a vertical stack of **occupied** voxels with a square footprint, surrounded by a
 //! hull of **free** voxels. Free space is only known by ray tracing, so the extractor builds
-//! a local 3-D grid of hit and miss counts from registered scans ([`HitMissGrid`]: an exact
-//! traversal walked slab by slab along the major axis with fixed-point side counters (no
-//! data-dependent branch per voxel), one share of the points per thread; cost linear in the
-//! voxels crossed, ≈ 120 per ray in a KITTI local map, which makes tracing about two thirds
-//! of the extraction time), turns the counts into the
-//! posterior probability that the reflection rate exceeds `μ_o` ([`ReflectionPrior`]:
-//! `o = 1 − I_{μ_o}(h + α, m + β)` with a method-of-moments Beta prior), and scores every
+//! a local 3-D grid of hit and miss counts from registered scans ([`HitMissGrid`]:
+//! `raypath-geometry`'s `SlabWalk`, an exact traversal walked slab by slab along the major
+//! axis with fixed-point side counters (no data-dependent branch per voxel), one share of the
+//! points per thread; cost linear in the voxels crossed, ≈ 120 per ray in a KITTI local map,
+//! which makes tracing about two thirds of the extraction time), turns the counts into the
+//! posterior probability that the reflection rate exceeds `μ_o` ([`occupancy`]:
+//! `o = 1 − I_{μ_o}(h + α, m + β)` with the method-of-moments Beta prior of
+//! `raypath-sensor-models`, `BetaPrior`), and scores every
 //! voxel for every footprint width `a` (`q_a` = best placement of mean occupancy inside
 //! minus the maximum of the hull; [`pole_scores`], separable running maxima and box sums,
 //! no per-voxel neighbourhood loops). Per column the longest run with `Q ≥ q_min` taller
@@ -26,11 +27,13 @@
 //! Mapping ([`local_maps`], [`reference_map`]): local maps along trajectory segments,
 //! merged by overlapping ground-plane squares with score weights ([`merge_poles`]); the
 //! c-of-w window ([`SlidingWindowFilter`]) drops transient poles. Localization
-//! ([`PoleFilter`]): odometry motion model, nearest-neighbour association through a k-d tree
-//! (`kiddo`) gated at `d_max`, `Π (φ_σ(d) + ε)` weights, low-variance resampling at
-//! `n_eff/N < 0.5`, estimate = weighted mean of the best 10 %. [`localize_run`] evaluates a
-//! run every 1 m of ground-truth arc length (`raypath-localizer::eval`). [`Drive`] reads KITTI
-//! and NCLT layouts.
+//! ([`PoleFilter`]) is `raypath-localizer`'s particle filter with its Gaussian odometry
+//! motion model and the pole measurement model [`PoleLikelihood`]: nearest-neighbour
+//! association through a k-d tree (`kiddo`) gated at `d_max`, `Π (φ_σ(d) + ε)` weights;
+//! low-variance resampling at `n_eff/N < 0.5`, estimate = weighted mean of the best 10 %.
+//! [`localize_run`] evaluates a run every 1 m of ground-truth arc length
+//! (`raypath-localizer::eval`). A [`Drive`] is a sweep sequence read by `raypath-io` (KITTI,
+//! NCLT, bags, Ouster captures, or in memory) with the pipeline's conventions.
 //!
 //! Real sweeps: a de-skewed sweep of a moving sensor (KITTI's) holds its points in one frame,
 //! but each beam started where the sensor was when it fired; rays traced from the frame's
@@ -127,14 +130,11 @@ mod mapping;
 mod params;
 mod pipeline;
 mod pole;
-mod pole_map;
 mod reference;
 mod score;
 mod sweep;
-mod tracer;
 
-pub use beta::ReflectionPrior;
-pub use drive::{Drive, DriveFormat, ScanError, ScanFn};
+pub use drive::{Drive, DriveFormat};
 pub use error::{PoleError, Result};
 pub use extract::{
     ExtractionStats, extract_poles, extract_poles_from_sweeps, local_grid, non_maximum_suppression,
@@ -142,7 +142,7 @@ pub use extract::{
 };
 pub use hitmiss::HitMissGrid;
 pub use labelled::{LabelledLocalMap, ScoringRegion};
-pub use localize::{FilterParams, PoleFilter, PoleIndex};
+pub use localize::{FilterParams, PoleFilter, PoleIndex, PoleLikelihood};
 pub use mapping::{Segment, SlidingWindowFilter, merge_poles, overlap_clusters, segments};
 pub use params::PoleParams;
 pub use pipeline::{
@@ -150,9 +150,6 @@ pub use pipeline::{
     detection_quality, filter_run, local_maps, localize_run, online_poles, reference_map,
 };
 pub use pole::Pole;
-pub use pole_map::{
-    POLE_MAP_HEADER, parse_pole_csv, read_pole_csv, write_pole_csv, write_pole_csv_to,
-};
 pub use reference::{
     PoleClass, ReferencePole, ReferenceRule, ReferenceSet, class_quality, greedy_matches,
     reference_poles,

@@ -155,7 +155,7 @@ pub fn local_maps(
     );
     let motions = drive
         .sweep_timing
-        .map(|timing| SweepMotion::from_poses(track, &drive.stamps_secs, timing));
+        .map(|timing| SweepMotion::from_poses(track, &drive.sweeps.stamps_secs, timing));
     let mut totals = ExtractionTotals::default();
     let mut out = Vec::with_capacity(segs.len());
     // Scans of the previous segment are kept (overlapping segments share them).
@@ -166,7 +166,7 @@ pub fn local_maps(
         cache.retain(|(i, _)| wanted.contains(i));
         for &i in &wanted {
             if !cache.iter().any(|(j, _)| *j == i) {
-                cache.push((i, drive.scan(i)?));
+                cache.push((i, drive.sweeps.sweep(i)?));
             }
         }
         totals.read_secs += read.elapsed().as_secs_f64();
@@ -284,7 +284,7 @@ pub fn localize_run(
         seed,
     )?;
     let gt_track = PoseTrack::from_parts(
-        drive.stamps_secs[first..end].to_vec(),
+        drive.sweeps.stamps_secs[first..end].to_vec(),
         gt[first..end].iter().map(Pose3::to_planar).collect(),
     )?;
     let evaluation = evaluate_trajectory(&gt_track, &estimate, &EvaluationConfig::default())?;
@@ -316,15 +316,15 @@ pub fn filter_run(
 ) -> Result<(PoseTrack<Pose2>, usize, f64)> {
     let end = range.end.min(drive.len());
     let first = range.start.min(end);
-    if registration.len() < end || drive.odometry.len() < end {
+    if registration.len() < end || drive.odometry().len() < end {
         return Err(PoleError::Sequence {
-            path: drive.dir.clone(),
+            path: drive.sweeps.name.clone(),
             reason: "the registration or odometry track is shorter than the drive".into(),
         });
     }
     if end - first < 2 {
         return Err(PoleError::Sequence {
-            path: drive.dir.clone(),
+            path: drive.sweeps.name.clone(),
             reason: "fewer than two scans to localize on".into(),
         });
     }
@@ -335,12 +335,12 @@ pub fn filter_run(
         name: "noise",
         reason: e.to_string(),
     })?;
-    let mut stamps = vec![drive.stamps_secs[first]];
+    let mut stamps = vec![drive.sweeps.stamps_secs[first]];
     let mut estimates = vec![filter.estimate()];
     let (mut updates, mut update_secs) = (0, 0.0);
     let mut next_online = online.iter().peekable();
     for k in first + 1..end {
-        let increment = planar(&drive.odometry[k - 1]).inverse() * planar(&drive.odometry[k]);
+        let increment = planar(&drive.odometry()[k - 1]).inverse() * planar(&drive.odometry()[k]);
         let (increment, std) = match noise {
             OdometryNoise::Relative { fraction } => {
                 let std = [increment.x(), increment.y(), increment.theta()]
@@ -356,7 +356,12 @@ pub fn filter_run(
                 std_scale,
                 fallback,
             } => {
-                let stated = drive.odometry_std.as_ref().and_then(|s| s.get(k)).copied();
+                let stated = drive
+                    .sweeps
+                    .odometry_std
+                    .as_ref()
+                    .and_then(|s| s.get(k))
+                    .copied();
                 let std = match stated {
                     Some(s) => s.map(|v| (v * std_scale).max(1e-4)),
                     None => [increment.x(), increment.y(), increment.theta()]
@@ -365,7 +370,7 @@ pub fn filter_run(
                 (increment, std)
             }
         };
-        filter.predict(&increment, std);
+        filter.predict(&increment, std)?;
         while let Some((done, poles)) = next_online.peek() {
             if *done > k {
                 break;
@@ -378,13 +383,13 @@ pub fn filter_run(
                     .map(|p| robot_from_reg.transform_point(&Point2::new(p.x, p.y)))
                     .collect();
                 let started = Instant::now();
-                filter.update(&observed);
+                filter.update(&observed)?;
                 update_secs += started.elapsed().as_secs_f64();
                 updates += 1;
             }
             next_online.next();
         }
-        stamps.push(drive.stamps_secs[k]);
+        stamps.push(drive.sweeps.stamps_secs[k]);
         estimates.push(filter.estimate());
     }
     let estimate = PoseTrack::from_parts(stamps, estimates)?;

@@ -57,7 +57,7 @@ proptest! {
                 0.02 * rng.random_range(-1.0..1.0),
                 0.002 * rng.random_range(-1.0..1.0),
             );
-            filter.predict(&noisy, [0.02, 0.02, 0.002]);
+            filter.predict(&noisy, [0.02, 0.02, 0.002]).expect("predict");
             if k % 3 == 0 {
                 let robot_from_world = truth.inverse();
                 let mut seen: Vec<Point2<f64>> = map
@@ -68,7 +68,7 @@ proptest! {
                     .collect();
                 // A pole that is not in the map.
                 seen.push(Point2::new(rng.random_range(-10.0..10.0), 6.0));
-                filter.update(&seen);
+                filter.update(&seen).expect("update");
             }
             let e = truth.inverse() * filter.estimate();
             errors.push((e.x().hypot(e.y()), e.theta().abs()));

@@ -10,8 +10,8 @@
 //!   00–07 (`RAYPATH_DATA/kitti-poles/NN`; missing ones are skipped with a note). Each drive
 //!   is simulated in memory ([`SemiKittiDrive`]: the street world built around the drive,
 //!   HDL-64E scans produced on demand while the local maps are built) and streamed through
-//!   [`Drive::from_fn`]; nothing is written to disk. `POLES_KITTI_SEQUENCES=00,07` restricts
-//!   the run to the listed sequences (`none`: the real section alone).
+//!   [`SweepSequence::from_fn`]; nothing is written to disk. `POLES_KITTI_SEQUENCES=00,07`
+//!   restricts the run to the listed sequences (`none`: the real section alone).
 //! * Same-drive protocol (as the thesis, `kittipoles.py`): local maps every 3 m over 5 m of
 //!   trajectory with the ground-truth poses, merged into the reference map; localization on
 //!   the same drive with 2000 particles, 3 m / ±5° initial spread, increments corrupted by
@@ -48,10 +48,11 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use nalgebra::Point2;
 use raypath_geometry::Pose3;
+use raypath_io::poles_csv::read_pole_csv;
+use raypath_io::sequence::{SweepError, SweepFormat, SweepSequence};
 use raypath_poles::{
-    Drive, DriveFormat, ExtractionTotals, LocalMap, OdometryNoise, Pole, Preset, RunResult,
-    ScanError, detection_quality, local_maps, localize_run, online_poles, read_pole_csv,
-    reference_map,
+    Drive, ExtractionTotals, LocalMap, OdometryNoise, Pole, Preset, RunResult, detection_quality,
+    local_maps, localize_run, online_poles, reference_map,
 };
 use raypath_sim::datasets::DEFAULT_SEED;
 use raypath_sim::semi_kitti::{SemiKittiConfig, SemiKittiDrive};
@@ -243,14 +244,14 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         );
         let gt = sim.world_from_velo.clone();
         let source = Arc::clone(&sim);
-        let drive = Drive::from_fn(
+        let drive = Drive::new(SweepSequence::from_fn(
             &label,
-            DriveFormat::Kitti,
+            SweepFormat::Kitti,
             sim.times_s.clone(),
             Some(gt.clone()),
-            gt.clone(),
-            Box::new(move |i| source.scan(i).map_err(|e| Box::new(e) as ScanError)),
-        )?;
+            Some(gt.clone()),
+            Box::new(move |i| source.scan(i).map_err(|e| Box::new(e) as SweepError)),
+        )?)?;
         let positions: Vec<Point2<f64>> = gt
             .iter()
             .map(|p| {

@@ -31,9 +31,10 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use nalgebra::{Point2, Point3};
 use raypath_geometry::Pose3;
+use raypath_io::sequence::{SweepFormat, SweepSequence};
 use raypath_poles::{
-    Drive, DriveFormat, ExtractionTotals, LocalMap, OdometryNoise, Pole, Preset, detection_quality,
-    local_maps, localize_run, merge_poles, online_poles,
+    Drive, ExtractionTotals, LocalMap, OdometryNoise, Pole, Preset, detection_quality, local_maps,
+    localize_run, merge_poles, online_poles,
 };
 use raypath_sim::semi_nclt::{SemiNclt, SemiNcltConfig};
 use serde_json::json;
@@ -169,15 +170,16 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
 fn semi_session(campus: &SemiNclt, k: usize) -> Result<Session> {
     let s = campus.session(k)?;
     let scan = s.scan_fn();
-    let mut drive = Drive::from_fn(
+    let mut sweeps = SweepSequence::from_fn(
         &format!("semi-nclt {}", s.date),
-        DriveFormat::Nclt,
+        SweepFormat::Nclt,
         s.stamps_secs.clone(),
         Some(s.ground_truth.to_vec()),
-        s.odometry.clone(),
+        Some(s.odometry.clone()),
         Box::new(move |i| scan(i).map_err(Into::into)),
     )?;
-    drive.odometry_std = Some(s.odometry_std.clone());
+    sweeps.odometry_std = Some(s.odometry_std.clone());
+    let drive = Drive::new(sweeps)?;
     let truth = s
         .poles
         .iter()
@@ -323,10 +325,11 @@ fn evaluate(
         let gt = drive.require_ground_truth()?;
         let open_secs = opened.elapsed().as_secs_f64();
         let bar = ctx.progress(0, "online maps");
-        let (online_maps, totals) = local_maps(drive, &drive.odometry, 0..end, &preset, |d, t| {
-            bar.set_length(t as u64);
-            bar.set_position(d as u64);
-        })?;
+        let (online_maps, totals) =
+            local_maps(drive, drive.odometry(), 0..end, &preset, |d, t| {
+                bar.set_length(t as u64);
+                bar.set_position(d as u64);
+            })?;
         bar.finish_and_clear();
         let online = online_poles(&online_maps, &preset);
         let online_secs = opened.elapsed().as_secs_f64() - open_secs;
@@ -338,7 +341,7 @@ fn evaluate(
                 0..end,
                 &map,
                 &online,
-                &drive.odometry,
+                drive.odometry(),
                 &preset.filter,
                 OdometryNoise::Recorded {
                     std_scale: 2.0,

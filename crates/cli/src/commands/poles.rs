@@ -38,11 +38,12 @@ mod record;
 use std::path::PathBuf;
 
 use raypath_geometry::{Pose2, Pose3};
+use raypath_io::poles_csv::{PoleRecord, read_pole_csv, write_pole_csv};
 use raypath_localizer::PoseTrack;
 use raypath_localizer::eval::{EvaluationConfig, evaluate_trajectory};
 use raypath_poles::{
     Drive, DriveFormat, OdometryNoise, Pole, Preset, RunResult, filter_run, local_maps,
-    online_poles, read_pole_csv, reference_map, write_pole_csv,
+    online_poles, reference_map,
 };
 use serde_json::json;
 
@@ -192,20 +193,23 @@ pub fn run(args: &Args) -> Result<(), Failure> {
 }
 
 fn open(common: &Common) -> Result<(Drive, Preset, std::ops::Range<usize>), Failure> {
-    let mut drive = Drive::open_with(&common.sequence, &common.source.sweep_options())
+    let sweeps = common
+        .source
+        .open_sweeps(&common.sequence)
         .map_err(Failure::input)?;
+    let mut drive = Drive::new(sweeps).map_err(Failure::input)?;
     let kitti_timing = match common.sweep_timing {
         SweepTimingArg::Kitti => true,
         SweepTimingArg::Origin => false,
         SweepTimingArg::Auto => {
-            drive.format == DriveFormat::Kitti && !simulated_set(&common.sequence)
+            drive.format() == DriveFormat::Kitti && !simulated_set(&common.sequence)
         }
     };
     drive.sweep_timing = kitti_timing.then(raypath_poles::SweepTiming::kitti);
     let preset = match common.preset {
         Some(PresetArg::Nclt) => Preset::nclt(),
         Some(PresetArg::Kitti) => Preset::kitti(),
-        None => match drive.format {
+        None => match drive.format() {
             DriveFormat::Kitti => Preset::kitti(),
             DriveFormat::Nclt => Preset::nclt(),
         },
@@ -225,7 +229,7 @@ fn open(common: &Common) -> Result<(Drive, Preset, std::ops::Range<usize>), Fail
 }
 
 fn preset_name(common: &Common, drive: &Drive) -> &'static str {
-    match (common.preset, drive.format) {
+    match (common.preset, drive.format()) {
         (Some(PresetArg::Nclt), _) | (None, DriveFormat::Nclt) => "nclt",
         _ => "kitti",
     }
@@ -248,6 +252,11 @@ fn poles_json(poles: &[Pole]) -> serde_json::Value {
         .collect()
 }
 
+/// The rows of a pole-map CSV.
+fn records(poles: &[Pole]) -> Vec<PoleRecord> {
+    poles.iter().map(PoleRecord::from).collect()
+}
+
 fn print_poles(poles: &[Pole]) {
     println!(
         "{:>10} {:>10} {:>8} {:>8} {:>6}",
@@ -267,9 +276,10 @@ fn print_poles(poles: &[Pole]) {
 
 fn mapping_track(drive: &Drive) -> Vec<Pose3> {
     drive
-        .ground_truth
+        .sweeps
+        .reference
         .clone()
-        .unwrap_or_else(|| drive.odometry.clone())
+        .unwrap_or_else(|| drive.odometry().to_vec())
 }
 
 fn extract(args: &ExtractArgs) -> Result<(), Failure> {
@@ -282,7 +292,7 @@ fn extract(args: &ExtractArgs) -> Result<(), Failure> {
     let poles = maps.first().map(|m| m.poles.clone()).unwrap_or_default();
     let scans = maps.first().map_or(0, |m| m.scans.len());
     if let Some(out) = &args.out {
-        write_pole_csv(out, &poles).map_err(Failure::input)?;
+        write_pole_csv(out, &records(&poles)).map_err(Failure::input)?;
     }
     if let Some(recording) = &mut recording {
         let used = maps.first().map(|m| m.scans.clone()).unwrap_or_default();
@@ -322,7 +332,7 @@ fn map(args: &MapArgs) -> Result<(), Failure> {
     let (maps, totals) =
         local_maps(&drive, &track, range.clone(), &preset, |_, _| {}).map_err(Failure::input)?;
     let poles = reference_map(&maps, &preset);
-    write_pole_csv(&args.out, &poles).map_err(Failure::input)?;
+    write_pole_csv(&args.out, &records(&poles)).map_err(Failure::input)?;
     if let Some(recording) = &mut recording {
         let used: Vec<usize> = range.collect();
         record::mapping(recording, &drive, &track, &used, &poles)?;
@@ -366,14 +376,18 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
     }
     preset.filter.validate().map_err(Failure::input)?;
     let mut recording = Recording::open(&c.record)?;
-    let map = read_pole_csv(&args.map).map_err(Failure::input)?;
+    let map: Vec<Pole> = read_pole_csv(&args.map)
+        .map_err(Failure::input)?
+        .into_iter()
+        .map(Pole::from)
+        .collect();
     if map.is_empty() {
         return Err(Failure::input(format!(
             "{}: the pole map is empty",
             args.map.display()
         )));
     }
-    let start = match (&args.start, &drive.ground_truth) {
+    let start = match (&args.start, &drive.sweeps.reference) {
         (Some(v), _) => match v.as_slice() {
             [x, y, theta] if x.is_finite() && y.is_finite() && theta.is_finite() => {
                 Pose2::new(*x, *y, *theta)
@@ -396,11 +410,11 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
         }
     };
     // Online poles: local maps along the odometry (KITTI: the poses, see the module docs).
-    let registration = drive.odometry.clone();
+    let registration = drive.odometry().to_vec();
     let (maps, _) = local_maps(&drive, &registration, range.clone(), &preset, |_, _| {})
         .map_err(Failure::input)?;
     let online = online_poles(&maps, &preset);
-    let noise = match drive.format {
+    let noise = match drive.format() {
         DriveFormat::Kitti => OdometryNoise::Relative { fraction: 0.02 },
         DriveFormat::Nclt => OdometryNoise::Recorded {
             std_scale: 2.0,
@@ -432,10 +446,10 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
         if let Some(last) = track.poses().last() {
             finals.push(json!({"x": last.x(), "y": last.y(), "theta": last.theta()}));
         }
-        if let Some(gt) = &drive.ground_truth {
+        if let Some(gt) = &drive.sweeps.reference {
             let end = range.end.min(gt.len());
             let gt_track = PoseTrack::from_parts(
-                drive.stamps_secs[range.start..end].to_vec(),
+                drive.sweeps.stamps_secs[range.start..end].to_vec(),
                 gt[range.start..end].iter().map(Pose3::to_planar).collect(),
             )
             .map_err(Failure::input)?;

@@ -10,11 +10,16 @@
 //! directions are unit vectors, so `t_exit − t_enter` is the in-cell path length `d_i` that
 //! the decay-rate model of Schaefer (2020, ch. 7) sums into `R_i = Σ d_i`.
 //!
-//! The contract is documented on [`Traversal`].
+//! The contract is documented on [`Traversal`]. [`SlabWalk`] is a fast path for counting
+//! the voxels segments cross (hit/miss grids): the same voxels, walked slab by slab along the
+//! major axis without per-voxel `t` comparisons.
 
 mod grid;
+mod slab;
 #[cfg(test)]
 mod tests;
+
+pub use slab::{SlabWalk, SlabWalkEnd};
 
 /// One cell crossed by a traversal: which cell, and the ray parameter interval (metres along
 /// the unit direction) the ray spends inside it.

@@ -365,6 +365,40 @@ impl SweepSequence {
             .as_deref()
             .ok_or_else(|| bad(&self.name, "no odometry poses"))
     }
+
+    /// The sequence with an odometry track for every sweep: the recorded odometry, else the
+    /// reference poses for the layouts that record none (KITTI, whose odometry benchmark
+    /// gives poses only; bags without an odometry topic; Ouster captures). Fails, naming the
+    /// sequence and the file the poses would come from, when neither track is there, and for
+    /// an NCLT session without odometry covering every sweep time (NCLT records its odometry;
+    /// the ground truth is no stand-in for it).
+    pub fn with_odometry_or_reference(mut self) -> Result<Self> {
+        if self.odometry.is_some() {
+            return Ok(self);
+        }
+        let missing = match self.format {
+            SweepFormat::Nclt => {
+                "the NCLT session has no odometry covering every scan time \
+                 (odometry_mu_100hz.csv)"
+            }
+            SweepFormat::Kitti => {
+                "the KITTI sequence has no pose for every scan in poses.txt (KITTI odometry \
+                 comes from the poses)"
+            }
+            SweepFormat::Bag => "the bag has neither odometry nor reference poses for every sweep",
+            SweepFormat::Ouster => {
+                "the Ouster capture has no poses for its frames (<capture stem>_poses_kitti.txt \
+                 beside the .pcap)"
+            }
+        };
+        match (self.format, self.reference.clone()) {
+            (SweepFormat::Kitti | SweepFormat::Bag | SweepFormat::Ouster, Some(reference)) => {
+                self.odometry = Some(reference);
+                Ok(self)
+            }
+            _ => Err(bad(&self.name, missing)),
+        }
+    }
 }
 
 /// The poses of a table at `stamps` (linear in position, slerp in rotation); `None` when the
@@ -411,3 +445,6 @@ fn check_increasing(name: &Path, stamps: &[f64]) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests;

@@ -97,6 +97,36 @@ impl BetaPrior {
         Self::new(alpha, beta).unwrap_or_default()
     }
 
+    /// Method of moments like [`from_moments`](Self::from_moments), but degenerate moments
+    /// are clamped instead of replaced by the uniform prior: the mean `E` into
+    /// `[1e-6, 1 − 1e-6]` (0.5 when not finite), the concentration `α + β = E(1−E)/V − 1` to
+    /// at least `min_concentration` (also when `V` is 0 or not finite). So the prior keeps
+    /// the data's mean and, for a (nearly) binary ML map, where the moments admit no Beta
+    /// distribution, a weight of `min_concentration` pseudo-observations, negligible beside
+    /// one count (the pole extractor's occupancy, Schaefer 2020, §12.4.1).
+    pub fn from_moments_clamped(moments: &MomentStatistics, min_concentration: f64) -> Self {
+        let floor = if min_concentration.is_finite() {
+            min_concentration.max(f64::MIN_POSITIVE)
+        } else {
+            f64::MIN_POSITIVE
+        };
+        let e = if moments.mean.is_finite() {
+            moments.mean.clamp(1e-6, 1.0 - 1e-6)
+        } else {
+            0.5
+        };
+        let common = e * (1.0 - e) / moments.variance - 1.0; // Sec. 8.5, rearranged
+        let common = if common.is_finite() {
+            common.max(floor)
+        } else {
+            floor
+        };
+        Self {
+            alpha: e * common,
+            beta: (1.0 - e) * common,
+        }
+    }
+
     /// Method of moments over the ML reflection map of `cells` (uniform prior when no cell
     /// was observed).
     pub fn estimate<'a>(cells: impl IntoIterator<Item = &'a CellStats>) -> Self {
@@ -186,6 +216,32 @@ mod tests {
         let alpha = -e * (e * e - e + v) / v;
         let beta = (e - v + e * v - 2.0 * e * e + e * e * e) / v;
         assert!((prior.alpha - alpha).abs() < 1e-12 && (prior.beta - beta).abs() < 1e-12);
+    }
+
+    #[test]
+    fn clamped_beta_moments_keep_the_mean_of_degenerate_data() {
+        // Regular moments: the same prior as `from_moments`.
+        let moments = MomentStatistics {
+            cells: 10,
+            mean: 0.25,
+            variance: 12.0 / 576.0,
+        };
+        let prior = BetaPrior::from_moments_clamped(&moments, 1e-3);
+        assert_eq!(prior, BetaPrior::from_moments(&moments));
+        assert!((prior.alpha - 2.0).abs() < 1e-9 && (prior.beta - 6.0).abs() < 1e-9);
+        // A binary map (V = E(1 − E)): the concentration is clamped, the mean kept.
+        let binary = MomentStatistics::of([1.0, 0.0, 1.0, 0.0, 0.0]).unwrap();
+        let prior = BetaPrior::from_moments_clamped(&binary, 1e-3);
+        assert!((prior.alpha + prior.beta - 1e-3).abs() < 1e-15);
+        assert!((prior.mean() - 0.4).abs() < 1e-12);
+        // No data: mean 0.5 at the floor.
+        let none = MomentStatistics {
+            cells: 0,
+            mean: f64::NAN,
+            variance: f64::NAN,
+        };
+        let prior = BetaPrior::from_moments_clamped(&none, 1e-3);
+        assert_eq!((prior.alpha, prior.beta), (5e-4, 5e-4));
     }
 
     #[test]

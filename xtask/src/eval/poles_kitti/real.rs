@@ -19,9 +19,10 @@
 //!   ways.
 
 use anyhow::{Context, Result};
+use raypath_io::poles_csv::read_pole_csv;
 use raypath_poles::{
     LabelledLocalMap, PoleClass, PoleParams, ReferencePole, ReferenceRule, SweepMotion,
-    SweepTiming, greedy_matches, read_pole_csv,
+    SweepTiming, greedy_matches,
 };
 use raypath_sim::datasets::DEFAULT_SEED;
 use raypath_sim::semi_kitti::SemiKittiDrive;

@@ -22,8 +22,8 @@ pub fn mapping(
     let mut poses = Vec::new();
     let max_points = sweep_points(scans.len());
     for &i in scans {
-        if let (Some(pose), Some(stamp)) = (track.get(i), drive.stamps_secs.get(i)) {
-            let cloud = drive.scan(i).map_err(Failure::input)?;
+        if let (Some(pose), Some(stamp)) = (track.get(i), drive.sweeps.stamps_secs.get(i)) {
+            let cloud = drive.sweeps.sweep(i).map_err(Failure::input)?;
             recording.sweep(*stamp, pose, &cloud, max_points)?;
             poses.push(*pose);
         }
@@ -43,11 +43,16 @@ pub fn localization(
     map: &[Pole],
     estimate: &PoseTrack<Pose2>,
 ) -> Result<(), Failure> {
-    let start = drive.stamps_secs.get(range.start).copied().unwrap_or(0.0);
+    let start = drive
+        .sweeps
+        .stamps_secs
+        .get(range.start)
+        .copied()
+        .unwrap_or(0.0);
     recording.scene(topic::POLES, start, frame::MAP, &pole_entities(map, "pole"))?;
     let max_points = sweep_points(estimate.len());
     for (i, sample) in range.clone().zip(estimate.iter()) {
-        let cloud = drive.scan(i).map_err(Failure::input)?;
+        let cloud = drive.sweeps.sweep(i).map_err(Failure::input)?;
         recording.sweep(
             sample.stamp_secs,
             &sample.pose.to_pose3(),
@@ -57,7 +62,7 @@ pub fn localization(
     }
     let end = recording.end_stamp();
     recording.planar_trajectory(topic::TRAJECTORY, end, estimate.poses())?;
-    if let Some(truth) = &drive.ground_truth {
+    if let Some(truth) = &drive.sweeps.reference {
         let truth = truth.get(range).unwrap_or_default();
         recording.trajectory(topic::GROUND_TRUTH, end, truth)?;
     }
