@@ -130,7 +130,7 @@ fn optimize_is_never_worse_and_svg_is_written() {
     assert_eq!(optimized["method"], "PLE+");
     assert_eq!(optimized["optimizer"], "levenberg-marquardt");
     let picture = std::fs::read_to_string(&svg).unwrap();
-    assert!(picture.starts_with("<svg") && picture.contains("<path"));
+    assert!(picture.starts_with("<svg") && picture.contains("<polyline"));
 }
 
 #[test]

@@ -65,7 +65,7 @@
 //! | `optimize` | PLE+: Levenberg–Marquardt (default) and Nelder–Mead |
 //! | `baselines` | VVL, IEF, SAM |
 //! | [`metrics`] | RMSE, f, area error a (both denominators), IoU |
-//! | [`svg`] | a picture of scan and polylines |
+//! | `svg` (feature `svg`) | a picture of scan and polylines, with axes |
 //!
 //! ## Defaults and their sources
 //!
@@ -120,6 +120,7 @@ mod optimize;
 mod ple;
 mod polyline;
 mod rays;
+#[cfg(feature = "svg")]
 pub mod svg;
 
 pub use config::{Method, Optimizer, PolylineConfig};

@@ -19,28 +19,40 @@
 //! scan counts as 8 independent beams; every beam is mixed with a random reading of weight
 //! ε = 0.05, AMCL's `z_rand`, because the ray-casting models have no false-detection term
 //! and single no-return or unmapped-space beams otherwise decide the weights).
+//!
+//! In stages: one unit per 2-D data set (the first one present also measures the filter
+//! speed), one for the 3-D drive and one for the corridor; the page ([`page`]) from their
+//! results.
 
 mod common;
 mod fmp;
+mod page;
 mod planar;
 mod spatial;
 mod speed;
 
 use std::path::PathBuf;
 
-use anyhow::Result;
-use raypath_localizer::lidar::{DEFAULT_RANDOM_WEIGHT, LidarConfig, ModelKind, ModelSpec};
+use anyhow::{Result, bail};
+use raypath_localizer::lidar::{LidarConfig, ModelKind, ModelSpec};
 use raypath_sensor_models::GammaPrior;
-use serde_json::json;
+use serde::{Deserialize, Serialize};
+use serde_json::{Value, json};
 
-use super::{EvalContext, EvalReport, comparable};
-use crate::table::{Table, fmt_num};
+use super::stages::{self, Staged, UnitResults};
+use super::{EvalContext, EvalReport};
 use common::Cell;
+use speed::SpeedRow;
 
+const NAME: &str = "mcl";
 /// Particles of the 2-D accuracy runs (the thesis's count for its 3-D runs).
 const PARTICLES_2D: usize = 300;
 /// Beam step of the 2-D accuracy runs (every 2nd of 180 beams).
 const BEAM_STEP_2D: usize = 2;
+/// The 3-D unit.
+const URBAN: &str = "urban";
+/// The corridor's unit.
+const CORRIDOR: &str = "corridor";
 
 struct Settings {
     seeds: Vec<u64>,
@@ -95,531 +107,275 @@ fn models_2d() -> Vec<ModelSpec> {
     ]
 }
 
-/// The 2-D data sets: name, kind, raw log, corrected log.
-fn datasets_2d(
-    ctx: &EvalContext,
-    indoor_worlds: usize,
-) -> Result<Vec<(String, &'static str, PathBuf, PathBuf)>> {
-    let mut out = Vec::new();
-    for (name, raw, corrected) in [
-        (
-            "intel",
-            "carmen/raw/intel.clf.bz2",
-            "carmen/corrected/intel-corrected.log.gz",
-        ),
-        (
-            "fr079",
-            "carmen/raw/fr079.clf.bz2",
-            "carmen/corrected/freiburg-079-corrected.log.gz",
-        ),
-    ] {
-        let (raw, corrected) = (ctx.data(raw), ctx.data(corrected));
-        if raw.exists() && corrected.exists() {
-            out.push((name.to_owned(), "real", raw, corrected));
-        } else {
-            eprintln!(
-                "mcl: skipping {name}: {} or {} absent",
-                raw.display(),
-                corrected.display()
-            );
-        }
-    }
-    let indoor = crate::generate::ensure("indoor", ctx.quick)?;
-    for world in ["office", "hall", "lab"].into_iter().take(indoor_worlds) {
-        let find = |stem: &str| {
-            ["", ".gz", ".bz2"]
-                .iter()
-                .map(|ext| indoor.join(format!("{stem}{ext}")))
-                .find(|p| p.exists())
-        };
-        if let (Some(raw), Some(corrected)) = (
-            find(&format!("{world}.clf")),
-            find(&format!("{world}-corrected.log")),
-        ) {
-            out.push((format!("indoor/{world}"), "simulated", raw, corrected));
-        }
-    }
-    Ok(out)
+/// The models of the speed table.
+fn speed_models() -> Vec<ModelSpec> {
+    vec![
+        ModelSpec::exact(ModelKind::LikelihoodField),
+        ModelSpec::tabulated(ModelKind::Endpoint),
+        ModelSpec::tabulated(ModelKind::DecayRate),
+        ModelSpec {
+            posterior: true,
+            ..ModelSpec::tabulated(ModelKind::DecayRate)
+        },
+        ModelSpec::tabulated(ModelKind::Reflection),
+        ModelSpec::exact(ModelKind::DecayRate),
+        ModelSpec::exact(ModelKind::Reflection),
+    ]
 }
 
-/// Runs the evaluation.
-pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
-    let s = settings(ctx.quick);
-    let lidar = LidarConfig {
+/// The 2-D accuracy runs' sensor configuration.
+fn lidar_2d() -> LidarConfig {
+    LidarConfig {
         beam_step: BEAM_STEP_2D,
         ..LidarConfig::default()
-    };
-    let track = planar::track_config(PARTICLES_2D);
-    let specs = s.models.clone();
-    let mut cells: Vec<(String, &'static str, Cell)> = Vec::new();
-    let mut speed_rows = Vec::new();
-    let mut problems_json = Vec::new();
-    // The Gamma prior of the decay-rate FMP per map (Sec. 8.5), as `ModelSpec::build` estimates it.
-    let mut priors: Vec<(String, GammaPrior)> = Vec::new();
+    }
+}
 
-    for (name, kind, raw, corrected) in datasets_2d(ctx, s.indoor_worlds)? {
-        eprintln!("mcl: loading {name}");
-        let problem = planar::load(&name, &raw, &corrected, s.gt_scans)?;
-        priors.push((name.clone(), GammaPrior::estimate(problem.stats.cells())));
-        problems_json.push(json!({
-            "dataset": name, "kind": kind,
+/// The evaluation in stages (`--shard i/n` and `eval merge`).
+pub const STAGED: Staged = Staged {
+    name: NAME,
+    units,
+    run_unit,
+    report,
+};
+
+/// Runs the evaluation (every data set, then the report).
+pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
+    stages::run_all(&STAGED, ctx)
+}
+
+/// The 2-D data sets in report order: the real logs, then the simulated indoor worlds.
+fn planar_units(ctx: &EvalContext) -> Vec<String> {
+    let worlds = ["office", "hall", "lab"].into_iter();
+    ["intel", "fr079"]
+        .into_iter()
+        .map(str::to_owned)
+        .chain(
+            worlds
+                .take(settings(ctx.quick).indoor_worlds)
+                .map(|w| format!("indoor/{w}")),
+        )
+        .collect()
+}
+
+/// The 2-D data sets, the 3-D drive and the corridor.
+fn units(ctx: &EvalContext) -> Result<Vec<String>> {
+    let mut units = planar_units(ctx);
+    units.extend([URBAN.to_owned(), CORRIDOR.to_owned()]);
+    Ok(units)
+}
+
+/// A 2-D data set: real or simulated, raw log, corrected log.
+struct PlanarData {
+    real: bool,
+    raw: PathBuf,
+    corrected: PathBuf,
+}
+
+/// The files of 2-D data set `name`; `None` (with a message for a real log) when absent.
+fn planar_data(ctx: &EvalContext, name: &str) -> Result<Option<PlanarData>> {
+    let real_log = |raw: &str, corrected: &str| {
+        let (raw, corrected) = (ctx.data(raw), ctx.data(corrected));
+        if raw.exists() && corrected.exists() {
+            return Some(PlanarData {
+                real: true,
+                raw,
+                corrected,
+            });
+        }
+        eprintln!(
+            "mcl: skipping {name}: {} or {} absent",
+            raw.display(),
+            corrected.display()
+        );
+        None
+    };
+    let world = match name {
+        "intel" => {
+            return Ok(real_log(
+                "carmen/raw/intel.clf.bz2",
+                "carmen/corrected/intel-corrected.log.gz",
+            ));
+        }
+        "fr079" => {
+            return Ok(real_log(
+                "carmen/raw/fr079.clf.bz2",
+                "carmen/corrected/freiburg-079-corrected.log.gz",
+            ));
+        }
+        _ => match name.strip_prefix("indoor/") {
+            Some(world) => world,
+            None => bail!("mcl: no data set {name:?}"),
+        },
+    };
+    let indoor = crate::generate::ensure("indoor", ctx.quick)?;
+    let find = |stem: &str| {
+        ["", ".gz", ".bz2"]
+            .iter()
+            .map(|ext| indoor.join(format!("{stem}{ext}")))
+            .find(|p| p.exists())
+    };
+    Ok(find(&format!("{world}.clf"))
+        .zip(find(&format!("{world}-corrected.log")))
+        .map(|(raw, corrected)| PlanarData {
+            real: false,
+            raw,
+            corrected,
+        }))
+}
+
+/// What one unit measured.
+#[derive(Serialize, Deserialize)]
+enum UnitResult {
+    /// A 2-D data set (`None`: absent).
+    Planar(Option<PlanarResult>),
+    /// The 3-D drive (`None`: not generated) and the note on simulated scans.
+    Spatial {
+        drive: Option<SpatialResult>,
+        gap_note: String,
+    },
+    /// The corridor section: markdown and JSON.
+    Corridor { markdown: String, json: Value },
+}
+
+/// One 2-D data set's results.
+#[derive(Serialize, Deserialize)]
+struct PlanarResult {
+    name: String,
+    real: bool,
+    /// The data set's row of `datasets_2d`.
+    problem: Value,
+    /// The Gamma prior of the decay-rate FMP on this map (Sec. 8.5), as `ModelSpec::build`
+    /// estimates it.
+    prior: GammaPrior,
+    cells: Vec<Cell>,
+    /// The speed table (on the first 2-D data set present; empty on the others).
+    speed: Vec<SpeedRow>,
+}
+
+/// The 3-D drive's results.
+#[derive(Serialize, Deserialize)]
+struct SpatialResult {
+    prior: GammaPrior,
+    map_rays: u64,
+    frames: usize,
+    cells: Vec<Cell>,
+}
+
+fn run_unit(ctx: &EvalContext, unit: &str) -> Result<Value> {
+    let result = match unit {
+        URBAN => UnitResult::Spatial {
+            drive: run_spatial(ctx)?,
+            gap_note: super::sim::gap_note(ctx).unwrap_or_else(|e| {
+                format!("(How far the simulation is from real scans: {e:#})\n")
+            }),
+        },
+        CORRIDOR => {
+            let (markdown, json) = super::corridor::section(ctx)?;
+            UnitResult::Corridor { markdown, json }
+        }
+        _ => UnitResult::Planar(run_planar(ctx, unit)?),
+    };
+    Ok(serde_json::to_value(result)?)
+}
+
+/// Whether `name` is the first 2-D data set present (the one the speed table runs on).
+fn first_present(ctx: &EvalContext, name: &str) -> Result<bool> {
+    for unit in planar_units(ctx) {
+        if unit == name {
+            return Ok(true);
+        }
+        if planar_data(ctx, &unit)?.is_some() {
+            return Ok(false);
+        }
+    }
+    Ok(false)
+}
+
+/// Every 2-D model on data set `name` (and the speed table when it is the first present).
+fn run_planar(ctx: &EvalContext, name: &str) -> Result<Option<PlanarResult>> {
+    let Some(data) = planar_data(ctx, name)? else {
+        return Ok(None);
+    };
+    let s = settings(ctx.quick);
+    eprintln!("mcl: loading {name}");
+    let problem = planar::load(name, &data.raw, &data.corrected, s.gt_scans)?;
+    let track = planar::track_config(PARTICLES_2D);
+    let cells = s
+        .models
+        .iter()
+        .map(|spec| planar::run_model(&problem, spec, lidar_2d(), &track, &s.seeds, || {}))
+        .collect::<Result<Vec<_>>>()?;
+    let mut speed = Vec::new();
+    if first_present(ctx, name)? {
+        for spec in &speed_models() {
+            let exact = spec.tabulated.is_none() && spec.kind != ModelKind::LikelihoodField;
+            let updates = if exact {
+                s.speed_updates.1
+            } else {
+                s.speed_updates.0
+            };
+            speed.push(speed::measure(&problem, spec, updates)?);
+        }
+    }
+    Ok(Some(PlanarResult {
+        name: name.to_owned(),
+        real: data.real,
+        problem: json!({
+            "dataset": name, "kind": page::kind(data.real),
             "raw_steps": problem.steps.len(),
             "ground_truth_scans": problem.ground_truth.len(),
             "corrected_scans": problem.corrected_scans,
             "grid": problem.stats.grid().dims(),
-        }));
-        let bar = ctx.progress((specs.len() * s.seeds.len()) as u64, &name);
-        for spec in &specs {
-            let cell = planar::run_model(&problem, spec, lidar, &track, &s.seeds, || bar.inc(1))?;
-            cells.push((name.clone(), kind, cell));
+        }),
+        prior: GammaPrior::estimate(problem.stats.cells()),
+        cells,
+        speed,
+    }))
+}
+
+/// Every 3-D model on the simulated drive and on its campus*-style variant.
+fn run_spatial(ctx: &EvalContext) -> Result<Option<SpatialResult>> {
+    let root = match crate::generate::ensure("urban-kitti", ctx.quick) {
+        Ok(root) => root,
+        Err(error) => {
+            eprintln!("mcl: skipping the 3-D drive: {error:#}");
+            return Ok(None);
         }
-        bar.finish_and_clear();
-        // Speed table on the first (preferably real Intel) map.
-        if speed_rows.is_empty() {
-            let mut speed_specs = vec![
-                ModelSpec::exact(ModelKind::LikelihoodField),
-                ModelSpec::tabulated(ModelKind::Endpoint),
-                ModelSpec::tabulated(ModelKind::DecayRate),
-                ModelSpec {
-                    posterior: true,
-                    ..ModelSpec::tabulated(ModelKind::DecayRate)
-                },
-                ModelSpec::tabulated(ModelKind::Reflection),
-            ];
-            speed_specs.push(ModelSpec::exact(ModelKind::DecayRate));
-            speed_specs.push(ModelSpec::exact(ModelKind::Reflection));
-            let bar = ctx.progress(speed_specs.len() as u64, "speed");
-            for spec in &speed_specs {
-                let updates = if spec.tabulated.is_some() || spec.kind == ModelKind::LikelihoodField
-                {
-                    s.speed_updates.0
-                } else {
-                    s.speed_updates.1
-                };
-                let row = speed::measure(&problem, spec, updates)?;
-                speed_rows.push((name.clone(), row));
-                bar.inc(1);
-            }
-            bar.finish_and_clear();
+    };
+    let s = settings(ctx.quick);
+    eprintln!("mcl: loading urban-kitti");
+    let problem = spatial::load(&root, s.frames_3d)?;
+    let failing = spatial::with_failures(&problem);
+    let models = spatial::models(&problem)?;
+    let mut cells = Vec::new();
+    for (set, frames) in [("urban", &problem.frames), ("urban*", &failing)] {
+        for (label, model) in &models {
+            let cell = spatial::run_model(set, label, model.as_ref(), frames, &s.seeds, || {})?;
+            cells.push(cell);
         }
     }
+    Ok(Some(SpatialResult {
+        prior: GammaPrior::estimate(problem.stats.cells()),
+        map_rays: problem.map_rays,
+        frames: problem.frames.len(),
+        cells,
+    }))
+}
 
-    // 3-D.
-    let mut cells_3d: Vec<Cell> = Vec::new();
-    let mut map_rays_3d = 0;
-    let mut frames_3d = 0;
-    match crate::generate::ensure("urban-kitti", ctx.quick) {
-        Ok(root) => {
-            eprintln!("mcl: loading urban-kitti");
-            let problem = spatial::load(&root, s.frames_3d)?;
-            priors.push((
-                "urban".to_owned(),
-                GammaPrior::estimate(problem.stats.cells()),
-            ));
-            map_rays_3d = problem.map_rays;
-            frames_3d = problem.frames.len();
-            let failing = spatial::with_failures(&problem);
-            let models = spatial::models(&problem)?;
-            let bar = ctx.progress((2 * models.len() * s.seeds.len()) as u64, "urban 3-D");
-            for (label, model) in &models {
-                cells_3d.push(spatial::run_model(
-                    "urban",
-                    label,
-                    model.as_ref(),
-                    &problem.frames,
-                    &s.seeds,
-                    || bar.inc(1),
-                )?);
-            }
-            for (label, model) in &models {
-                cells_3d.push(spatial::run_model(
-                    "urban*",
-                    label,
-                    model.as_ref(),
-                    &failing,
-                    &s.seeds,
-                    || bar.inc(1),
-                )?);
-            }
-            bar.finish_and_clear();
-        }
-        Err(error) => eprintln!("mcl: skipping the 3-D drive: {error:#}"),
-    }
-
-    let (corridor_markdown, corridor_json) = super::corridor::section(ctx)?;
-    let markdown = report_markdown(
-        ctx,
-        &s,
-        &cells,
-        &cells_3d,
-        &speed_rows,
-        frames_3d,
-        map_rays_3d,
-        &corridor_markdown,
-        &priors,
-    )?;
-    let json = json!({
-        "settings": {
-            "seeds": s.seeds, "ground_truth_scans_per_log": s.gt_scans,
-            "particles_2d": PARTICLES_2D, "beam_step_2d": BEAM_STEP_2D,
-            "particles_3d": spatial::PARTICLES, "rays_per_scan_3d": spatial::RAYS_PER_SCAN,
-            "frames_3d": frames_3d, "lidar": lidar, "track": track,
-        },
-        "datasets_2d": problems_json,
-        "rows_2d": cells.iter().map(|(_, kind, c)| { let mut v = c.json(); v["kind"] = json!(kind); v }).collect::<Vec<_>>(),
-        "rows_3d": cells_3d.iter().map(Cell::json).collect::<Vec<_>>(),
-        "speed": speed_rows.iter().map(|(d, r)| json!({
-            "map": d, "model": r.model, "particles": speed::PARTICLES, "beams": r.beams,
-            "updates_per_s": r.updates_per_s, "build_secs": r.build_secs,
-        })).collect::<Vec<_>>(),
-        "speed_3d": cells_3d.iter().filter(|c| c.dataset == "urban").map(|c| json!({
-            "model": c.model, "particles": spatial::PARTICLES, "updates_per_s": c.updates_per_s(),
-        })).collect::<Vec<_>>(),
-        "corridor": corridor_json,
-        "decay_rate_fmp_vs_mlm": fmp::json(&cells, &cells_3d, &priors),
-    });
+/// The page from every unit's result.
+fn report(ctx: &EvalContext, results: &UnitResults) -> Result<EvalReport> {
+    let units: Vec<UnitResult> = stages::decode(results)?;
+    let m = page::Measured::of(units);
+    let s = settings(ctx.quick);
+    let markdown = page::report_markdown(ctx, &s, &m)?;
     Ok(EvalReport {
         name: "mcl",
         title: "Monte-Carlo localization per sensor model".to_owned(),
         markdown,
-        json,
+        json: page::json(&s, &m),
         headline: None,
     })
-}
-
-/// Fixed notes on the set-up (what differs from the thesis).
-const NOTES: &str = "
-## Notes
-
-- **Real vs simulated**: `intel` and `fr079` are real Radish logs (raw odometry and scans; map and ground truth \
-from the corrected logs, paired with the raw scans by identical readings, `raypath_io::sequence::pair_reference`); \
-`indoor/*` and `urban*` are simulated (`datasets/generated`).
-- **Maps and localization scans**: for the real logs the map is built from all corrected scans, which are the \
-same laser readings as the raw scans with ground truth (the corrected logs are subsampled raw logs), so mapping \
-and localization data are not disjoint there (the thesis's are); the raw scans between them are not in the map. \
-The simulated indoor maps are built from the corrected (noise-free pose) log of the same run; the 3-D maps from \
-the even frames only, localization on the odd ones (disjoint, as in the thesis).
-- **Likelihood exponent**: full-scan likelihoods are far too peaked (Eq. 7.15 treats beams as independent); every \
-model is tempered the same way, `ln p̃ = γ Σ ln p(z_j)` with γ = 8 / (kept beams) (`raypath_localizer::lidar`). \
-The thesis does not say how it kept its filters healthy (motion model, resampling, estimator and rays per scan are not given in Sec. 7.5).
-- **Outlier beams**: every beam of every model is mixed with a random reading, `p̃ = (1 − ε) p + ε q` with ε = 0.05 (AMCL's `z_rand`; `q` = no-return or uniform return on [0, r_max), each with probability ½), because the ray-casting models have no false-detection term and a single no-return through glass or unmapped space otherwise costs tens to hundreds of nats (`LidarConfig::random_weight`). The runs that still diverge start with the initial mean 1.6–2.4 m from the truth and never converge: with 300 particles no particle reaches the narrow basin of the ray-casting likelihoods (on intel, decay-rate started with the mean at the truth converged in 10/10 runs even without the mixture).
-- **Filter**: systematic resampling when ESS / N < 0.5, estimate = mean of the best 10 % of the particles, 2-D \
-updates after 0.2 m / 0.2 rad of odometry and at every scan with ground truth, errors evaluated \
-on the estimates at the scans with ground truth (both tracks interpolated over the same stamps); 3-D motion from ground-truth \
-increments with the 6-DOF Gaussian noise model (`Gaussian6DofMotionModel::default()`).
-- **Endpoint** = the likelihood field normalized per ray to a density (Sec. 7.6.2); **likelihood-field** = AMCL's \
-unnormalized value; **(FMP)** = full map posterior (ch. 8).
-- **Decay-rate MLM vs FMP** (Sec. 8.5.2, Measure 3): both filters use the same map statistics, seeds, initial \
-particles, exponent and mixture and differ only in the weighting — MLM Eq. (7.13) on `λ_i = H_i / R_i` (floored at \
-1e-3 /m), FMP the closed-form `L(z, x)` of Sec. 8.4.5 under `Gamma(H_i + α, R_i + β)`. The prior's α, β are \
-estimated once per map by the method of moments of Sec. 8.5 (`GammaPrior::estimate`: `α = E²/V`, `β = E/V` with \
-E, V the mean and variance of the ML rates `H_i / R_i` over the cells with `R_i > 0`; `Gamma(1, 1/E)` when V = 0), \
-as `ModelSpec { posterior: true, .. }` builds it; the values per map are listed under the FMP table. They come out \
-small (a weak prior): the variance of the ML rates is dominated by the few cells where rays end millimetres after \
-entering (`H_i / R_i` of hundreds per metre), so the posterior of a rarely crossed cell is wide and its FMP \
-likelihood has heavy (Lomax) tails in the in-cell length. The 2-D FMP \
-rows use the optical-depth table like the MLM rows (each crossed cell counted at the mean chord of its direction, \
-`Tabulated<DecayRatePosteriorModel2>`; on the Intel map its scan log-likelihoods are within 0.6 % (median) of the \
-exact ones); the 3-D rows traverse exactly. The thesis ran Measure 3 in 6-DOF with 3000 particles on the real park \
-drive; our 3-D rows keep this page's 300 particles on the simulated drive.
-";
-
-/// Thesis Table 7.2 (position error in metres, DEC / REF / END, 300 particles, 3-D).
-const THESIS: [(&str, [f64; 3]); 4] = [
-    ("campus", [0.230, 0.284, 0.280]),
-    ("campus*", [0.252, 0.284, 0.366]),
-    ("forest", [0.331, 0.352, 0.417]),
-    ("park", [0.088, 0.089, 0.124]),
-];
-
-/// The "comparable" cell of a thesis Table 7.2 row of the orderings table.
-fn thesis_comparable(name: &str) -> String {
-    let failures = if name == "campus*" {
-        ", 10 % of the rays set to r_min"
-    } else {
-        ""
-    };
-    comparable::no(&format!(
-        "thesis: real 3-D HDL-64E drive (VIONA robot, Applanix ground truth{failures}), \
-         not available here; none of our rows uses it"
-    ))
-}
-
-/// The "comparable" cell of one of our 2-D rows of the orderings table (`kind`: real or
-/// simulated).
-fn ours_comparable_2d(kind: &str) -> String {
-    if kind == "real" {
-        comparable::no(
-            "real 2-D Radish laser log (every 2nd beam, 0.1 m cells; map and localization \
-             scans not disjoint) vs the thesis' real 3-D HDL-64E drives; the ordering only",
-        )
-    } else {
-        comparable::no(&format!(
-            "{kind} 2-D indoor world (map from the same run's corrected log) vs the thesis' \
-             real 3-D HDL-64E drives; the ordering only"
-        ))
-    }
-}
-
-/// The "comparable" cell of one of our 3-D rows (`urban` or `urban*`) of the orderings table.
-fn ours_comparable_3d(set: &str) -> String {
-    let failures = if set == "urban*" {
-        " with campus*'s 10 % r_min failures"
-    } else {
-        ""
-    };
-    comparable::no(&format!(
-        "simulated HDL-64E urban drive{failures} (same 300 particles, 0.5 m voxels, disjoint map \
-         and test frames; {} rays per scan) vs the thesis' real drives; the ordering only",
-        spatial::RAYS_PER_SCAN
-    ))
-}
-
-/// The order of decay-rate (D), reflection (R), endpoint (E) by error, best first.
-fn ordering(errors: [f64; 3]) -> String {
-    let mut idx = [0usize, 1, 2];
-    idx.sort_by(|a, b| errors[*a].total_cmp(&errors[*b]));
-    idx.iter()
-        .map(|&i| ["D", "R", "E"][i])
-        .collect::<Vec<_>>()
-        .join(" < ")
-}
-
-fn dre(cells: &[&Cell]) -> Option<[f64; 3]> {
-    let find = |prefix: &str| {
-        cells
-            .iter()
-            .find(|c| c.model == prefix || c.model == format!("{prefix} [table]"))
-            .map(|c| c.converged_position())
-    };
-    Some([find("decay-rate")?, find("reflection")?, find("endpoint")?])
-}
-
-#[allow(clippy::too_many_arguments)]
-fn report_markdown(
-    ctx: &EvalContext,
-    s: &Settings,
-    cells: &[(String, &'static str, Cell)],
-    cells_3d: &[Cell],
-    speed_rows: &[(String, speed::SpeedRow)],
-    frames_3d: usize,
-    map_rays_3d: u64,
-    corridor_markdown: &str,
-    priors: &[(String, GammaPrior)],
-) -> Result<String> {
-    let mut md = String::new();
-    let mode = if ctx.quick {
-        format!(
-            "**Quick mode**: {} seeds, the first {} ground-truth scans of each 2-D log, {} simulated indoor world(s), \
-             {} of the 2-D models, {} frames of the 3-D drive.",
-            s.seeds.len(),
-            s.gt_scans.unwrap_or(0),
-            s.indoor_worlds,
-            s.models.len(),
-            s.frames_3d
-        )
-    } else {
-        format!(
-            "Full mode: {} seeds per cell, the first {} ground-truth scans of each 2-D log (the whole log when shorter), \
-             {} frames of the 3-D drive.",
-            s.seeds.len(),
-            s.gt_scans.unwrap_or(0),
-            s.frames_3d
-        )
-    };
-    md.push_str(&format!(
-        "{mode}\n\nMean position error over time (evaluated every 1 m of ground-truth path), mean ± std over the seeded runs; \
-         heading error likewise (degrees); *diverged* = runs whose error exceeded 5 m after the first 10 % of the path; *converged runs* = the mean \
-         position error over the other runs. \
-         2-D: {PARTICLES_2D} particles, every {BEAM_STEP_2D}nd beam (90 of 180), odometry motion model (α = 0.2), \
-         map cell 0.1 m; every model uses the same likelihood exponent (the scan counts as 8 independent beams) and \
-         outlier mixture (ε = {DEFAULT_RANDOM_WEIGHT}), `LidarConfig::default()`. `[table]` = path integrals from the optical-depth table.\n\n"
-    ));
-
-    md.push_str("## Table 7.2 analogue: 2-D logs\n\n");
-    let mut table = Table::new([
-        "data set",
-        "real/sim",
-        "model",
-        "position error [m]",
-        "converged runs [m]",
-        "heading error [°]",
-        "diverged",
-        "updates/s",
-    ]);
-    for (name, kind, c) in cells {
-        table.row([
-            name.clone(),
-            (*kind).to_owned(),
-            c.model.clone(),
-            c.position_text(),
-            c.converged_text(),
-            c.heading_text(),
-            c.divergence_text(),
-            fmt_num(c.updates_per_s(), 0),
-        ]);
-    }
-    md.push_str(&table.to_markdown()?);
-
-    md.push_str("\n## Table 7.2 analogue: simulated 3-D urban drive (6-DOF)\n\n");
-    md.push_str(
-        &super::sim::gap_note(ctx)
-            .unwrap_or_else(|e| format!("(How far the simulation is from real scans: {e:#})\n")),
-    );
-    md.push('\n');
-    md.push_str(&format!(
-        "{} particles, {} rays per scan (subsampled), 0.5 m voxels, map from the even frames ({map_rays_3d} rays), \
-         localization on {frames_3d} odd frames; motion = ground-truth increments through the 6-DOF Gaussian model; \
-         *urban\\** sets 10 % of the rays to r_min = 1 m (the thesis's campus\\*).\n\n",
-        spatial::PARTICLES,
-        spatial::RAYS_PER_SCAN
-    ));
-    let mut table = Table::new([
-        "data set",
-        "model",
-        "position error [m]",
-        "converged runs [m]",
-        "heading error [°]",
-        "diverged",
-        "updates/s",
-    ]);
-    for c in cells_3d {
-        table.row([
-            c.dataset.clone(),
-            c.model.clone(),
-            c.position_text(),
-            c.converged_text(),
-            c.heading_text(),
-            c.divergence_text(),
-            fmt_num(c.updates_per_s(), 1),
-        ]);
-    }
-    md.push_str(&table.to_markdown()?);
-
-    md.push_str(
-        "\n## Orderings beside the thesis (D = decay-rate, R = reflection, E = endpoint)\n\n\
-         Ours: mean position error over the runs that did not diverge (the thesis reports that all its filters \
-         converged); the divergence counts are in the tables above.\n\n",
-    );
-    let mut table = Table::new([
-        "data set",
-        "source",
-        "D [m]",
-        "R [m]",
-        "E [m]",
-        "order (best first)",
-        comparable::HEADER,
-    ]);
-    for (name, errors) in THESIS {
-        table.row([
-            name.to_owned(),
-            "thesis Table 7.2 (3-D, real)".to_owned(),
-            fmt_num(errors[0], 3),
-            fmt_num(errors[1], 3),
-            fmt_num(errors[2], 3),
-            ordering(errors),
-            thesis_comparable(name),
-        ]);
-    }
-    let mut names: Vec<(String, &str)> = Vec::new();
-    for (name, kind, _) in cells {
-        if !names.iter().any(|(n, _)| n == name) {
-            names.push((name.clone(), kind));
-        }
-    }
-    let mut ours = Vec::new();
-    for (name, kind) in &names {
-        let group: Vec<&Cell> = cells
-            .iter()
-            .filter(|(n, _, _)| n == name)
-            .map(|(_, _, c)| c)
-            .collect();
-        if let Some(e) = dre(&group) {
-            ours.push(e);
-            table.row([
-                name.clone(),
-                format!("ours (2-D, {kind})"),
-                fmt_num(e[0], 3),
-                fmt_num(e[1], 3),
-                fmt_num(e[2], 3),
-                ordering(e),
-                ours_comparable_2d(kind),
-            ]);
-        }
-    }
-    for set in ["urban", "urban*"] {
-        let group: Vec<&Cell> = cells_3d.iter().filter(|c| c.dataset == set).collect();
-        if let Some(e) = dre(&group) {
-            ours.push(e);
-            table.row([
-                set.to_owned(),
-                "ours (3-D, simulated)".to_owned(),
-                fmt_num(e[0], 3),
-                fmt_num(e[1], 3),
-                fmt_num(e[2], 3),
-                ordering(e),
-                ours_comparable_3d(set),
-            ]);
-        }
-    }
-    md.push_str(&table.to_markdown()?);
-    let decay_best = ours.iter().filter(|e| e[0] <= e[1] && e[0] <= e[2]).count();
-    md.push_str(&format!(
-        "\nDecay-rate has the lowest error on {decay_best} of {} of our data sets (thesis: 4 of 4). \
-         The thesis's figures are 3-D Velodyne runs on real campus/forest/park data; ours are 2-D Radish logs, \
-         simulated indoor worlds and a simulated urban drive, so only the orderings compare.\n",
-        ours.len()
-    ));
-    md.push_str(&fmp::section(cells, cells_3d, priors)?);
-
-    md.push_str("\n## Filter update rate (2 cores)\n\n");
-    let mut table = Table::new([
-        "map",
-        "model",
-        "particles × beams",
-        "updates/s",
-        "aim",
-        "model build [s]",
-    ]);
-    for (map, r) in speed_rows {
-        let aim = if r.model.starts_with("likelihood-field") {
-            "≥ 200"
-        } else if r.model.starts_with("endpoint") {
-            ""
-        } else {
-            "≥ 20"
-        };
-        table.row([
-            map.clone(),
-            r.model.clone(),
-            format!("{} × {}", speed::PARTICLES, r.beams),
-            fmt_num(r.updates_per_s, 1),
-            aim.to_owned(),
-            fmt_num(r.build_secs, 1),
-        ]);
-    }
-    for c in cells_3d.iter().filter(|c| c.dataset == "urban") {
-        table.row([
-            "urban 3-D".to_owned(),
-            c.model.clone(),
-            format!("{} × {}", spatial::PARTICLES, spatial::RAYS_PER_SCAN),
-            fmt_num(c.updates_per_s(), 1),
-            String::new(),
-            String::new(),
-        ]);
-    }
-    md.push_str(&table.to_markdown()?);
-    md.push_str(
-        "\nOne update = predict + weight (rayon over particles) + systematic resampling; measured in this run on the \
-         shared 2-core machine.\n",
-    );
-    md.push_str(NOTES);
-    if corridor_markdown.trim_start().starts_with("## ") {
-        md.push_str(&format!("\n{corridor_markdown}"));
-    } else {
-        md.push_str(&format!("\n## The ch. 8 corridor\n\n{corridor_markdown}"));
-    }
-    Ok(md)
 }
 
 #[cfg(test)]
@@ -631,94 +387,100 @@ mod tests {
         Cell {
             dataset: dataset.to_owned(),
             model: model.to_owned(),
-            runs: vec![RunResult {
-                position_m,
-                heading_rad: 0.01,
-                diverged: false,
-                updates_per_s: 100.0,
-            }],
+            runs: vec![
+                RunResult {
+                    position_m,
+                    heading_rad: 0.01,
+                    diverged: false,
+                    updates_per_s: 100.0,
+                },
+                RunResult {
+                    position_m: f64::NAN,
+                    heading_rad: f64::NAN,
+                    diverged: true,
+                    updates_per_s: 90.0,
+                },
+            ],
         }
     }
 
-    /// The report renders (every row has the header's cell count) and the orderings table
-    /// says per row whether it compares with the thesis.
+    fn value(result: UnitResult) -> Value {
+        serde_json::to_value(result).unwrap()
+    }
+
+    /// The page from known unit results: an absent data set left out, the priors in unit
+    /// order, the speed rows on their map, the 3-D rows, the gap note and the corridor.
     #[test]
-    fn orderings_table_says_what_compares() {
+    fn report_from_known_units() {
+        let prior = |alpha| GammaPrior { alpha, beta: 2.0 };
+        let intel = PlanarResult {
+            name: "intel".to_owned(),
+            real: true,
+            problem: json!({"dataset": "intel", "kind": "real"}),
+            prior: prior(0.5),
+            cells: [
+                "decay-rate [table]",
+                "reflection [table]",
+                "endpoint [table]",
+            ]
+            .into_iter()
+            .zip([0.1, 0.2, 0.3])
+            .map(|(model, e)| cell("intel", model, e))
+            .collect(),
+            speed: vec![SpeedRow {
+                model: "decay-rate [table]".to_owned(),
+                beams: 180,
+                updates_per_s: 50.0,
+                build_secs: 1.5,
+            }],
+        };
+        let urban = SpatialResult {
+            prior: prior(0.25),
+            map_rays: 1234,
+            frames: 15,
+            cells: vec![cell("urban", "decay-rate", 0.4)],
+        };
+        let results = vec![
+            ("intel".to_owned(), value(UnitResult::Planar(Some(intel)))),
+            ("fr079".to_owned(), value(UnitResult::Planar(None))),
+            (
+                URBAN.to_owned(),
+                value(UnitResult::Spatial {
+                    drive: Some(urban),
+                    gap_note: "GAP NOTE\n".to_owned(),
+                }),
+            ),
+            (
+                CORRIDOR.to_owned(),
+                value(UnitResult::Corridor {
+                    markdown: "## Corridor\n\ntext\n".to_owned(),
+                    json: json!({"runs": 1}),
+                }),
+            ),
+        ];
         let ctx = EvalContext {
             workspace_root: crate::eval::workspace_root(),
             data_dir: std::env::temp_dir().join("raypath-mcl-test-absent-data"),
             quick: true,
             out_dir: crate::eval::workspace_root(),
         };
-        let mut cells = Vec::new();
-        for (name, kind) in [("intel", "real"), ("indoor/office", "simulated")] {
-            for (model, e) in [
-                ("decay-rate [table]", 0.04),
-                ("decay-rate (FMP) [table]", 0.035),
-                ("reflection [table]", 0.05),
-                ("endpoint [table]", 0.06),
-            ] {
-                cells.push((name.to_owned(), kind, cell(name, model, e)));
-            }
-        }
-        let cells_3d: Vec<Cell> = ["urban", "urban*"]
-            .into_iter()
-            .flat_map(|set| {
-                [("decay-rate", 0.2), ("reflection", 0.1), ("endpoint", 0.15)]
-                    .map(|(model, e)| cell(set, model, e))
-            })
-            .collect();
-        let md = report_markdown(
-            &ctx,
-            &settings(true),
-            &cells,
-            &cells_3d,
-            &[],
-            30,
-            0,
-            "",
-            &[],
-        )
-        .expect("report renders");
-        // The decay-rate MLM / FMP comparison sits in the orderings section, one row per
-        // data set that ran both.
-        let fmp = md
-            .split("### Decay-rate: full map posterior (FMP)")
-            .nth(1)
-            .expect("FMP subsection");
-        assert!(
-            fmp.lines()
-                .any(|l| l.starts_with("| intel ") && l.contains("no — real 2-D"))
-        );
-        assert!(
-            fmp.lines()
-                .any(|l| l.starts_with("| park ") && l.contains("Fig. 8.3"))
-        );
-        assert!(
-            settings(true)
-                .models
-                .iter()
-                .any(|m| m.posterior && m.kind == ModelKind::DecayRate)
-        );
-        let orderings = md
-            .split("## Orderings beside the thesis")
-            .nth(1)
-            .expect("orderings section");
-        let header = orderings
-            .lines()
-            .find(|l| l.starts_with("| data set"))
-            .expect("orderings table");
-        assert_eq!(comparable::last_cell(header), "comparable", "{header}");
-        let row = |start: &str| {
-            orderings
-                .lines()
-                .find(|l| l.starts_with(start))
-                .unwrap_or_default()
-                .to_owned()
-        };
-        assert!(row("| campus* ").contains("no — thesis: real 3-D HDL-64E drive"));
-        assert!(row("| campus* ").contains("r_min"));
-        assert!(row("| intel ").contains("no — real 2-D Radish laser log"));
-        assert!(row("| urban* ").contains("no — simulated HDL-64E urban drive with campus*"));
+        let page = report(&ctx, &results).unwrap();
+        let json = &page.json;
+        assert_eq!(json["datasets_2d"].as_array().map(Vec::len), Some(1));
+        assert_eq!(json["rows_2d"][0]["kind"], "real");
+        assert_eq!(json["speed"][0]["map"], "intel");
+        assert_eq!(json["settings"]["frames_3d"], 15);
+        assert_eq!(json["corridor"]["runs"], 1);
+        let priors = &json["decay_rate_fmp_vs_mlm"]["gamma_priors"];
+        assert_eq!(priors[0]["dataset"], "intel");
+        assert_eq!(priors[1]["dataset"], "urban");
+        let md = &page.markdown;
+        assert!(md.contains("map from the even frames (1234 rays), localization on 15 odd"));
+        assert!(md.contains("GAP NOTE"));
+        assert!(md.ends_with("\n## Corridor\n\ntext\n"), "{md}");
+        let row = md.lines().find(|l| l.starts_with("| intel ")).unwrap();
+        assert!(row.contains("| 1/2 "), "{row}");
+        let order = md.lines().find(|l| l.contains("ours (2-D, real)")).unwrap();
+        assert!(order.contains("D < R < E"), "{order}");
     }
 }

@@ -208,7 +208,14 @@ const EVALUATIONS: &[(&str, &str, EvalFn)] = &[
 
 /// Runs `name` (or `all`, or `list`).
 /// The evaluations written in stages: `--shard i/n` and `eval merge` work for these.
-const STAGED: &[&stages::Staged] = &[&carmen_angles::STAGED, &registration::STAGED];
+const STAGED: &[&stages::Staged] = &[
+    &carmen_angles::STAGED,
+    &registration::STAGED,
+    &octomap::STAGED,
+    &polylines::STAGED,
+    &dct::STAGED,
+    &mcl::STAGED,
+];
 
 fn staged(name: &str) -> Result<&'static stages::Staged> {
     STAGED

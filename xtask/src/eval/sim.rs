@@ -564,6 +564,9 @@ fn polygons_picture(set: &SetOnDisk, path: &Path) -> Result<bool> {
         top.dot(x, y, 1, [220, 40, 40]);
     }
     top.dot(0.0, 0.0, 3, [0, 0, 0]);
+    top.legend("ground-truth polygon", [40, 90, 200]);
+    top.legend("scan endpoints", [220, 40, 40]);
+    top.legend("sensor", [0, 0, 0]);
     top.save(path)?;
     Ok(true)
 }
@@ -589,6 +592,7 @@ fn log_picture(log: &Path, path: &Path) -> Result<bool> {
     for pair in trajectory.windows(2) {
         top.line(pair[0], pair[1], [220, 40, 40]);
     }
+    top.legend("path", [220, 40, 40]);
     top.save(path)?;
     Ok(true)
 }
@@ -675,6 +679,8 @@ fn kitti_top_down(set: &SetOnDisk, path: &Path) -> Result<bool> {
     for &(x, y) in &poles {
         top.dot(x, y, 2, [40, 90, 200]);
     }
+    top.legend("trajectory", [220, 40, 40]);
+    top.legend("ground-truth poles", [40, 90, 200]);
     top.save(path)?;
     Ok(true)
 }

@@ -187,6 +187,56 @@ pub fn merge(
     Ok((results, seconds))
 }
 
+/// The unit results decoded as `T`, in report order; an error names the unit that does not
+/// decode.
+pub fn decode<T: serde::de::DeserializeOwned>(results: &UnitResults) -> Result<Vec<T>> {
+    results
+        .iter()
+        .map(|(unit, value)| {
+            serde_json::from_value(value.clone()).with_context(|| format!("result of {unit}"))
+        })
+        .collect()
+}
+
+/// Serde for `f64` fields that may be NaN or infinite, `#[serde(with = "stages::float")]`:
+/// JSON has no such numbers (serde_json writes `null`, which does not read back as an `f64`),
+/// so they are written as the strings `"NaN"`, `"inf"` and `"-inf"`. Finite values stay
+/// numbers and round-trip exactly.
+pub mod float {
+    use serde::de::Error as _;
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    /// Writes a finite value as a number, NaN and ±∞ as strings.
+    pub fn serialize<S: Serializer>(value: &f64, serializer: S) -> Result<S::Ok, S::Error> {
+        match *value {
+            v if v.is_finite() => serializer.serialize_f64(v),
+            v if v.is_nan() => serializer.serialize_str("NaN"),
+            v if v > 0.0 => serializer.serialize_str("inf"),
+            _ => serializer.serialize_str("-inf"),
+        }
+    }
+
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum Written {
+        Number(f64),
+        Text(String),
+    }
+
+    /// Reads what [`serialize`] wrote.
+    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<f64, D::Error> {
+        match Written::deserialize(deserializer)? {
+            Written::Number(v) => Ok(v),
+            Written::Text(text) => match text.as_str() {
+                "NaN" => Ok(f64::NAN),
+                "inf" => Ok(f64::INFINITY),
+                "-inf" => Ok(f64::NEG_INFINITY),
+                _ => Err(D::Error::custom(format!("{text:?} is not a number"))),
+            },
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -286,5 +336,40 @@ mod tests {
         };
         let quick = merge(&TOY, &other, &shards).unwrap_err();
         assert!(format!("{quick:#}").contains("--quick"), "{quick:#}");
+    }
+
+    #[test]
+    fn non_finite_floats_survive_a_shard_file() {
+        #[derive(Debug, serde::Serialize, serde::Deserialize)]
+        struct Row {
+            #[serde(with = "super::float")]
+            x: f64,
+        }
+        for x in [
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            -0.0,
+            0.1 + 0.2,
+            1e300,
+        ] {
+            let text = serde_json::to_string(&Row { x }).unwrap();
+            let back: Row = serde_json::from_str(&text).unwrap();
+            let value: Row =
+                serde_json::from_value(serde_json::to_value(Row { x }).unwrap()).unwrap();
+            for y in [back.x, value.x] {
+                assert!(
+                    y.to_bits() == x.to_bits() || (x.is_nan() && y.is_nan()),
+                    "{x} {text}"
+                );
+            }
+        }
+        assert!(serde_json::from_str::<Row>(r#"{"x": "many"}"#).is_err());
+        let results = vec![("a".to_owned(), json!({"x": "inf"}))];
+        let rows: Vec<Row> = decode(&results).unwrap();
+        assert_eq!(rows[0].x, f64::INFINITY);
+        let bad = vec![("b".to_owned(), json!({"y": 1}))];
+        let error = decode::<Row>(&bad).unwrap_err();
+        assert!(format!("{error:#}").contains("result of b"), "{error:#}");
     }
 }

@@ -4,6 +4,7 @@
 use std::fmt::Write as _;
 
 use anyhow::Result;
+use raypath_dct_map::experiment::BASELINE_PIXEL_M;
 
 use super::thesis::*;
 use super::*;
@@ -87,12 +88,35 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
+/// The page below the load line: set-up, data, Tables 9.2–9.4 beside the thesis, the
+/// per-log table and the Fig. 9.1 pictures.
 pub(super) fn report_markdown(
     ctx: &EvalContext,
     cells: &[Cell],
-    infos: &[serde_json::Value],
+    infos: &[Value],
     sizes: &[usize],
 ) -> Result<String> {
+    let mut names: Vec<&str> = Vec::new();
+    for c in cells {
+        if !names.contains(&c.log.as_str()) {
+            names.push(&c.log);
+        }
+    }
+    let logs = logs_text(&names);
+    let mut md = intro(ctx);
+    md.push_str(&data_table(infos)?);
+    md.push_str(&rmse_table(cells, sizes, &logs)?);
+    md.push_str(&likelihood_table(cells, sizes, &logs)?);
+    md.push_str(&baseline_likelihood_table(cells, sizes, &logs)?);
+    md.push_str(&time_table(cells, sizes)?);
+    md.push_str(&baseline_time_table(cells, sizes)?);
+    md.push_str(&per_log_table(cells)?);
+    md.push_str(&fig_9_1(cells, sizes));
+    Ok(md)
+}
+
+/// The set-up.
+fn intro(ctx: &EvalContext) -> String {
     let mut md = String::new();
     let _ = writeln!(
         md,
@@ -112,6 +136,12 @@ pub(super) fn report_markdown(
             ""
         }
     );
+    md
+}
+
+/// The logs' patches and rays.
+fn data_table(infos: &[Value]) -> Result<String> {
+    let mut md = String::new();
     let _ = writeln!(md, "## Data\n");
     let mut t = Table::new([
         "log",
@@ -131,15 +161,22 @@ pub(super) fn report_markdown(
         ]);
     }
     md.push_str(&t.to_markdown()?);
-    let thesis = |n: usize| THESIS.iter().find(|t| t.0 == n);
-    let mut logs: Vec<&str> = Vec::new();
-    for c in cells {
-        if !logs.contains(&c.log.as_str()) {
-            logs.push(&c.log);
-        }
-    }
-    let logs = logs_text(&logs);
+    Ok(md)
+}
 
+/// The thesis' row for `n`² parameters.
+fn thesis_row(n: usize) -> Option<&'static ThesisRow> {
+    THESIS.iter().find(|t| t.0 == n)
+}
+
+/// The values of `f` over the cells with `n`² parameters.
+fn at(cells: &[Cell], n: usize, f: impl Fn(&Cell) -> f64) -> Vec<f64> {
+    cells.iter().filter(|c| c.size == n).map(f).collect()
+}
+
+/// Table 9.2: RMSE of p_ref, DCT beside grid (`logs`: what our logs are).
+fn rmse_table(cells: &[Cell], sizes: &[usize], logs: &str) -> Result<String> {
+    let mut md = String::new();
     let _ = writeln!(
         md,
         "\n## Table 9.2 — RMSE of p_ref against the ground truth\n"
@@ -162,21 +199,13 @@ pub(super) fn report_markdown(
         comparable::HEADER,
     ]);
     for &n in sizes {
-        let d: Vec<f64> = cells
-            .iter()
-            .filter(|c| c.size == n)
-            .map(|c| c.rmse)
-            .collect();
-        let g: Vec<f64> = cells
-            .iter()
-            .filter(|c| c.size == n)
-            .map(|c| c.grid_rmse)
-            .collect();
+        let d = at(cells, n, |c| c.rmse);
+        let g = at(cells, n, |c| c.grid_rmse);
         let (dm, ds) = mean_std(&d);
         let (gm, gs) = mean_std(&g);
         let p = paired_less(&d, &g) * 100.0;
         let wins = d.iter().zip(&g).filter(|(a, b)| a < b).count();
-        let th = thesis(n);
+        let th = thesis_row(n);
         let br = |v: f64, th: Option<f64>, dec: usize| match th {
             Some(x) => format!("{} ({})", fmt_num(v, dec), fmt_num(x, dec)),
             None => fmt_num(v, dec),
@@ -191,11 +220,16 @@ pub(super) fn report_markdown(
             br(p, th.map(|t| t.5), 2),
             br((1.0 - dm / gm) * 100.0, th.map(|t| t.6), 2),
             format!("{wins}/{}", d.len()),
-            rmse_comparable(&logs, n),
+            rmse_comparable(logs, n),
         ]);
     }
     md.push_str(&t.to_markdown()?);
+    Ok(md)
+}
 
+/// Table 9.3: held-back log-likelihood, DCT − grid.
+fn likelihood_table(cells: &[Cell], sizes: &[usize], logs: &str) -> Result<String> {
+    let mut md = String::new();
     let _ = writeln!(
         md,
         "\n## Table 9.3 — log-likelihood of the held-back rays, DCT − grid\n"
@@ -216,15 +250,11 @@ pub(super) fn report_markdown(
         comparable::HEADER,
     ]);
     for &n in sizes {
-        let d: Vec<f64> = cells
-            .iter()
-            .filter(|c| c.size == n)
-            .map(|c| c.ll - c.grid_ll)
-            .collect();
+        let d = at(cells, n, |c| c.ll - c.grid_ll);
         let neg: Vec<f64> = d.iter().map(|v| -v).collect();
         let zeros = vec![0.0; d.len()];
         let (m, s) = mean_std(&d);
-        let th = thesis(n);
+        let th = thesis_row(n);
         t.row([
             format!("{n}²"),
             format!(
@@ -240,12 +270,16 @@ pub(super) fn report_markdown(
             fmt_num(median(d.clone()), 1),
             fmt_num(paired_less(&neg, &zeros) * 100.0, 2),
             format!("{}/{}", d.iter().filter(|v| **v > 0.0).count(), d.len()),
-            likelihood_comparable(&logs),
+            likelihood_comparable(logs),
         ]);
     }
     md.push_str(&t.to_markdown()?);
-    md.push_str(&baseline_likelihood_table(cells, sizes, &logs)?);
+    Ok(md)
+}
 
+/// Table 9.4: DCT and grid mapping times, both solvers side by side.
+fn time_table(cells: &[Cell], sizes: &[usize]) -> Result<String> {
+    let mut md = String::new();
     let _ = writeln!(md, "\n## Table 9.4 — mapping time [s], median over logs\n");
     let _ = writeln!(
         md,
@@ -270,9 +304,8 @@ pub(super) fn report_markdown(
         comparable::HEADER,
     ]);
     for &n in sizes {
-        let sel: Vec<&Cell> = cells.iter().filter(|c| c.size == n).collect();
-        let med = |f: &dyn Fn(&Cell) -> f64| median(sel.iter().map(|c| f(c)).collect());
-        let th = thesis(n);
+        let med = |f: &dyn Fn(&Cell) -> f64| median(at(cells, n, f));
+        let th = thesis_row(n);
         let t500 = med(&|c| c.time500_s);
         t.row([
             format!("{n}²"),
@@ -292,8 +325,12 @@ pub(super) fn report_markdown(
         ]);
     }
     md.push_str(&t.to_markdown()?);
-    md.push_str(&baseline_time_table(cells, sizes)?);
+    Ok(md)
+}
 
+/// Every (log, size) cell.
+fn per_log_table(cells: &[Cell]) -> Result<String> {
+    let mut md = String::new();
     let _ = writeln!(md, "\n## Per log\n");
     let mut t = Table::new([
         "log",
@@ -326,23 +363,30 @@ pub(super) fn report_markdown(
         ]);
     }
     md.push_str(&t.to_markdown()?);
-    if cells.iter().any(|c| c.log == "intel") {
-        let _ = writeln!(md, "\n## Fig. 9.1 — Intel Research Lab patch\n");
+    Ok(md)
+}
+
+/// The Fig. 9.1 pictures of the Intel patch (when `intel` ran).
+fn fig_9_1(cells: &[Cell], sizes: &[usize]) -> String {
+    let mut md = String::new();
+    if !cells.iter().any(|c| c.log == "intel") {
+        return md;
+    }
+    let _ = writeln!(md, "\n## Fig. 9.1 — Intel Research Lab patch\n");
+    let _ = writeln!(
+        md,
+        "p_ref = 1 − exp(−λ) for the decay-rate maps, the occupancy probability (clamped to \
+         [0.001, 0.999], on the 0.05 m raster) for GPOM and the Hilbert map (as Fig. 9.2); blue \
+         0, green 0.5, yellow 1. DCT map, grid map, GPOM and Hilbert map with as many \
+         parameters, and the 0.05 m ground truth.\n"
+    );
+    for &n in sizes.iter().filter(|n| **n == 13 || **n == 40) {
         let _ = writeln!(
             md,
-            "p_ref = 1 − exp(−λ) for the decay-rate maps, the occupancy probability (clamped to \
-             [0.001, 0.999], on the 0.05 m raster) for GPOM and the Hilbert map (as Fig. 9.2); blue \
-             0, green 0.5, yellow 1. DCT map, grid map, GPOM and Hilbert map with as many \
-             parameters, and the 0.05 m ground truth.\n"
+            "| DCT {n}×{n} | grid {n}×{n} | GPOM, {n}² points | Hilbert map, {n}² components | ground truth 200×200 |\n|---|---|---|---|---|\n| ![](dct/intel-dct-{n}x{n}.png) | ![](dct/intel-grid-{n}x{n}.png) | ![](dct/intel-gpom-{n}x{n}.png) | ![](dct/intel-hm-{n}x{n}.png) | ![](dct/intel-truth-200x200.png) |\n"
         );
-        for &n in sizes.iter().filter(|n| **n == 13 || **n == 40) {
-            let _ = writeln!(
-                md,
-                "| DCT {n}×{n} | grid {n}×{n} | GPOM, {n}² points | Hilbert map, {n}² components | ground truth 200×200 |\n|---|---|---|---|---|\n| ![](dct/intel-dct-{n}x{n}.png) | ![](dct/intel-grid-{n}x{n}.png) | ![](dct/intel-gpom-{n}x{n}.png) | ![](dct/intel-hm-{n}x{n}.png) | ![](dct/intel-truth-200x200.png) |\n"
-            );
-        }
     }
-    Ok(md)
+    md
 }
 
 /// `ours (thesis)` with the thesis figure in units of 10⁴ as printed.

@@ -1,20 +1,25 @@
 //! Shared pieces of the MCL evaluation: per-run results and their summary over seeds.
 
 use raypath_localizer::eval::TrajectoryEvaluation;
+use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 
+use crate::eval::stages::float;
 use crate::table::fmt_num;
 
 /// One filter run, summarized.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
 pub struct RunResult {
     /// Mean position error over the evaluation points, metres.
+    #[serde(with = "float")]
     pub position_m: f64,
     /// Mean absolute heading error, radians.
+    #[serde(with = "float")]
     pub heading_rad: f64,
     /// Whether the run diverged (error above 5 m at some point after the first 10 %).
     pub diverged: bool,
     /// Filter updates per second of wall time.
+    #[serde(with = "float")]
     pub updates_per_s: f64,
 }
 
@@ -54,7 +59,7 @@ pub fn mean_std(values: &[f64]) -> (f64, f64) {
 }
 
 /// The results of one model on one data set over all seeds.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Cell {
     /// Data set name.
     pub dataset: String,

@@ -59,11 +59,38 @@ pub fn load(
     let mut raw_scans = read_scans(raw)?;
     let corrected_scans = read_scans(corrected)?;
     let robot_from_laser = raw_scans[0].robot_from_laser();
+    let (stats, mapping) = build_map(&corrected_scans)?;
+    let mut matched = ground_truth(&mut raw_scans, &corrected_scans, robot_from_laser);
+    if matched.len() < 2 {
+        bail!(
+            "{name}: only {} corrected scans matched raw scans",
+            matched.len()
+        );
+    }
+    if let Some(limit) = max_gt_scans {
+        matched.truncate(limit.max(2));
+    }
+    let ground_truth = PoseTrack::new(
+        matched
+            .iter()
+            .filter_map(|(j, pose)| raw_scans.get(*j).map(|f| Stamped::new(f.stamp_secs, *pose))),
+    )?;
+    Ok(PlanarProblem {
+        name: name.to_owned(),
+        stats,
+        mapping,
+        steps: steps(&raw_scans, &matched),
+        robot_from_laser,
+        ground_truth,
+        corrected_scans: corrected_scans.len(),
+    })
+}
 
-    // Map from all corrected scans at their corrected laser poses.
+/// The map from all corrected scans at their corrected laser poses.
+fn build_map(corrected_scans: &[PlanarFrame]) -> Result<(DenseStats2, MappingConfig)> {
     let mut bounds = Aabb2::empty();
     let mapping = MappingConfig::default();
-    for frame in &corrected_scans {
+    for frame in corrected_scans {
         let (pose, scan) = (frame.world_from_laser, &frame.scan);
         bounds.extend(&Point2::new(pose.x(), pose.y()));
         for (i, p) in scan.points(pose).enumerate() {
@@ -85,10 +112,18 @@ pub fn load(
         .map(|f| (f.world_from_laser, &f.scan))
         .collect();
     stats.insert_scans_par(&refs, &mapping);
+    Ok((stats, mapping))
+}
 
-    // Pair corrected scans with raw scans by identical readings; keep strictly increasing
-    // times (raw logs repeat a logger stamp now and then).
-    pair_reference(&mut raw_scans, &corrected_scans);
+/// The raw scans paired with corrected scans by identical readings: (raw index,
+/// `world_from_robot`), times strictly increasing (raw logs repeat a logger stamp now and
+/// then).
+fn ground_truth(
+    raw_scans: &mut [PlanarFrame],
+    corrected_scans: &[PlanarFrame],
+    robot_from_laser: Pose2,
+) -> Vec<(usize, Pose2)> {
+    pair_reference(raw_scans, corrected_scans);
     let mut matched: Vec<(usize, Pose2)> = Vec::new();
     let mut last_stamp = f64::NEG_INFINITY;
     for (j, frame) in raw_scans.iter().enumerate() {
@@ -99,19 +134,16 @@ pub fn load(
             matched.push((j, world_from_laser * robot_from_laser.inverse()));
         }
     }
-    if matched.len() < 2 {
-        bail!(
-            "{name}: only {} corrected scans matched raw scans",
-            matched.len()
-        );
-    }
-    if let Some(limit) = max_gt_scans {
-        matched.truncate(limit.max(2));
-    }
+    matched
+}
+
+/// The raw steps from the first to the last matched scan, an update forced at each matched
+/// one.
+fn steps(raw_scans: &[PlanarFrame], matched: &[(usize, Pose2)]) -> Vec<PlanarStep> {
     let first = matched[0].0;
     let last = matched[matched.len() - 1].0;
     let forced: std::collections::HashSet<usize> = matched.iter().map(|m| m.0).collect();
-    let steps: Vec<PlanarStep> = raw_scans[first..=last]
+    raw_scans[first..=last]
         .iter()
         .enumerate()
         .map(|(k, frame)| PlanarStep {
@@ -120,21 +152,7 @@ pub fn load(
             scan: frame.scan.clone(),
             force_update: forced.contains(&(first + k)),
         })
-        .collect();
-    let ground_truth = PoseTrack::new(
-        matched
-            .iter()
-            .filter_map(|(j, pose)| raw_scans.get(*j).map(|f| Stamped::new(f.stamp_secs, *pose))),
-    )?;
-    Ok(PlanarProblem {
-        name: name.to_owned(),
-        stats,
-        mapping,
-        steps,
-        robot_from_laser,
-        ground_truth,
-        corrected_scans: corrected_scans.len(),
-    })
+        .collect()
 }
 
 /// The 2-D filter settings of the evaluation.

@@ -7,21 +7,26 @@ use raypath_localizer::init::GaussianInit;
 use raypath_localizer::lidar::{LidarConfig, ModelSpec, Scan2Measurement};
 use raypath_localizer::motion::{OdometryControl, OdometryMotionModel};
 use raypath_localizer::{FilterConfig, ParticleFilter};
+use serde::{Deserialize, Serialize};
 
 use super::planar::PlanarProblem;
+use crate::eval::stages::float;
 
 /// Particles of the speed table.
 pub const PARTICLES: usize = 1000;
 
 /// Measured rate of one model.
+#[derive(Serialize, Deserialize)]
 pub struct SpeedRow {
     /// Model label.
     pub model: String,
     /// Beams per scan.
     pub beams: usize,
     /// Filter updates per second.
+    #[serde(with = "float")]
     pub updates_per_s: f64,
     /// Time to build the model (and its table), seconds.
+    #[serde(with = "float")]
     pub build_secs: f64,
 }
 

@@ -5,10 +5,11 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
-/// What the driver reports for one run.
-#[derive(Clone, Debug, Deserialize)]
+/// What the driver reports for one run (the query classes are not written back: a unit's
+/// result keeps the agreement computed from them).
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PeerRun {
     /// Points inserted.
     pub points: usize,
@@ -29,6 +30,7 @@ pub struct PeerRun {
     /// Time to visit all leaves and test occupancy, seconds.
     pub access_secs: f64,
     /// Classification of the query points: u, f, o.
+    #[serde(default, skip_serializing)]
     pub classes: String,
 }
 
@@ -50,11 +52,13 @@ pub fn build(root: &Path) -> Result<PathBuf, String> {
     if fresh(&binary) == Some(true) {
         return Ok(binary);
     }
+    // Built under a name of this process and renamed: shards on one machine may build at once.
+    let building = binary.with_extension(format!("building-{}", std::process::id()));
     let output = Command::new("g++")
         .args(["-O2", "-std=c++17"])
         .arg(&source)
         .arg("-o")
-        .arg(&binary)
+        .arg(&building)
         .args(["-loctomap", "-loctomath"])
         .output()
         .map_err(|e| format!("cannot run g++: {e}"))?;
@@ -64,6 +68,8 @@ pub fn build(root: &Path) -> Result<PathBuf, String> {
             String::from_utf8_lossy(&output.stderr)
         ));
     }
+    std::fs::rename(&building, &binary)
+        .map_err(|e| format!("cannot move the OctoMap driver into place: {e}"))?;
     Ok(binary)
 }
 

@@ -1,128 +1,220 @@
-//! Grouped bar charts (PNG, `image` crate) of ours vs OctoMap: one panel per data set, one
-//! group of bars per resolution, a log₁₀ value axis with a grid line and label per decade.
+//! Grouped bar charts (PNG) of ours vs OctoMap: one panel per data set (three to a row), one
+//! group of bars per resolution, a shared log₁₀ value axis with a grid line and a label per
+//! decade, and the legend of the four bars above the panels.
 
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use image::{Rgb, RgbImage};
+use plotters::prelude::*;
+
+use crate::render::canvas::{self, FONT};
+use crate::render::legend::{self, Entry, Mark};
 
 /// Bar colours: ours beam, OctoMap beam, ours end-point, OctoMap end-point.
-pub const COLORS: [[u8; 3]; 4] = [
-    [31, 91, 170],
-    [230, 120, 20],
-    [130, 180, 235],
-    [250, 200, 140],
+pub const COLORS: [RGBColor; 4] = [
+    RGBColor(31, 91, 170),
+    RGBColor(230, 120, 20),
+    RGBColor(130, 180, 235),
+    RGBColor(250, 200, 140),
 ];
+
+/// What the four bars of a group are, in [`COLORS`] order.
+const BARS: [&str; 4] = [
+    "ours, beam-based",
+    "OctoMap, beam-based",
+    "ours, end-point",
+    "OctoMap, end-point",
+];
+
+/// Panels in a row, and the size of a panel in pixels.
+const COLUMNS: usize = 3;
+const PANEL: (u32, u32) = (330, 250);
 
 /// One panel: a data set's groups (one per resolution), each with up to four bar values
 /// (`None` or non-positive = no bar).
 pub struct Panel {
-    /// Groups of bars, left to right, each with its label (digits, `.`, `e`, `-`).
+    /// Groups of bars, left to right, each with its label (the resolution in metres).
     pub groups: Vec<(String, [Option<f64>; 4])>,
 }
 
-/// 3 × 5 glyphs of the digits, `e`, `-` and `.`, rows top to bottom, 3 bits per row.
-fn glyph(c: char) -> [u8; 5] {
-    match c {
-        '0' => [7, 5, 5, 5, 7],
-        '1' => [2, 6, 2, 2, 7],
-        '2' => [7, 1, 7, 4, 7],
-        '3' => [7, 1, 7, 1, 7],
-        '4' => [5, 5, 7, 1, 1],
-        '5' => [7, 4, 7, 1, 7],
-        '6' => [7, 4, 7, 5, 7],
-        '7' => [7, 1, 1, 1, 1],
-        '8' => [7, 5, 7, 5, 7],
-        '9' => [7, 5, 7, 1, 7],
-        'e' => [0, 7, 7, 4, 7],
-        '-' => [0, 0, 7, 0, 0],
-        '.' => [0, 0, 0, 0, 2],
-        _ => [0; 5],
-    }
-}
-
-fn put(img: &mut RgbImage, x: i64, y: i64, color: [u8; 3]) {
-    if x >= 0 && y >= 0 && (x as u32) < img.width() && (y as u32) < img.height() {
-        img.put_pixel(x as u32, y as u32, Rgb(color));
-    }
-}
-
-fn rect(img: &mut RgbImage, x0: i64, y0: i64, x1: i64, y1: i64, color: [u8; 3]) {
-    for y in y0.min(y1)..y0.max(y1) {
-        for x in x0.min(x1)..x0.max(x1) {
-            put(img, x, y, color);
+/// Writes the chart of `panels` (titled with `names`, in order) to `path`; `y_label` names the
+/// plotted value.
+pub fn bar_chart(path: &Path, y_label: &str, names: &[&str], panels: &[Panel]) -> Result<()> {
+    let decades = decades(panels);
+    let entries: Vec<Entry> = BARS
+        .iter()
+        .zip(COLORS)
+        .map(|(label, color)| Entry::new(*label, color, Mark::Swatch))
+        .collect();
+    let columns = panels.len().clamp(1, COLUMNS);
+    let rows = panels.len().div_ceil(COLUMNS).max(1);
+    let width = columns as u32 * PANEL.0;
+    let top = legend::height(&entries, width - 20) + 8;
+    let size = (width, top + rows as u32 * PANEL.1);
+    canvas::png(path, size, |root| {
+        let (head, body) = root.split_vertically(top);
+        legend::draw(&head.margin(6, 0, 20, 0), &entries)?;
+        let cells = body.split_evenly((rows, columns));
+        for (k, (panel, area)) in panels.iter().zip(&cells).enumerate() {
+            let labels = Labels {
+                title: names.get(k).copied().unwrap_or(""),
+                x: (k + columns >= panels.len()).then_some("resolution r (m)"),
+                y: (k % columns == 0).then_some(y_label),
+            };
+            draw_panel(area, panel, decades, &labels)?;
         }
-    }
+        Ok(())
+    })
 }
 
-/// Draws `text` with its top-left corner at `(x, y)`, glyphs scaled by `scale`.
-fn text(img: &mut RgbImage, x: i64, y: i64, scale: i64, s: &str) {
-    for (i, c) in s.chars().enumerate() {
-        let rows = glyph(c);
-        for (r, bits) in rows.iter().enumerate() {
-            for col in 0..3 {
-                if bits & (4 >> col) != 0 {
-                    let px = x + (i as i64 * 4 + col) * scale;
-                    let py = y + r as i64 * scale;
-                    rect(img, px, py, px + scale, py + scale, [0, 0, 0]);
-                }
-            }
-        }
-    }
+/// The texts of a panel: its title and its axis labels (`None`: not on this panel).
+struct Labels<'a> {
+    title: &'a str,
+    x: Option<&'a str>,
+    y: Option<&'a str>,
 }
 
-/// Writes the chart to `path`.
-pub fn bar_chart(path: &Path, panels: &[Panel]) -> Result<()> {
-    let values: Vec<f64> = panels
+/// The decades `(d0, d1)` spanned by the positive finite values (at least one).
+fn decades(panels: &[Panel]) -> (i32, i32) {
+    let values = panels
         .iter()
         .flat_map(|p| p.groups.iter().flat_map(|g| g.1.iter().flatten().copied()))
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .collect();
-    let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let (d0, d1) = if lo.is_finite() && hi.is_finite() {
-        let d0 = lo.log10().floor() as i32;
-        (d0, (hi.log10().ceil() as i32).max(d0 + 1))
-    } else {
-        (0, 1)
-    };
-    let (bar_w, group_gap, panel_gap, left, top, plot_h, bottom) = (9i64, 10, 24, 44, 12, 260, 20);
-    let panel_w: Vec<i64> = panels
-        .iter()
-        .map(|p| p.groups.len().max(1) as i64 * (4 * bar_w + group_gap) + group_gap)
-        .collect();
-    let width = left + panel_w.iter().sum::<i64>() + panel_gap * panels.len() as i64;
-    let height = top + plot_h + bottom;
-    let mut img = RgbImage::from_pixel(width as u32, height as u32, Rgb([255, 255, 255]));
-    let y_of = |v: f64| {
-        let f = (v.log10() - f64::from(d0)) / f64::from(d1 - d0);
-        top + plot_h - (f.clamp(0.0, 1.0) * plot_h as f64).round() as i64
-    };
-    // Decade grid lines and labels.
-    for d in d0..=d1 {
-        let y = y_of(10f64.powi(d));
-        rect(&mut img, left - 3, y, width, y + 1, [215, 215, 215]);
-        text(&mut img, 2, y - 5, 2, &format!("1e{d}"));
+        .filter(|v| v.is_finite() && *v > 0.0);
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
+    if !lo.is_finite() {
+        return (0, 1);
     }
-    let mut x0 = left;
-    for (panel, w) in panels.iter().zip(&panel_w) {
-        let base = top + plot_h;
-        rect(&mut img, x0, top, x0 + 1, base, [0, 0, 0]);
-        rect(&mut img, x0, base, x0 + w, base + 1, [0, 0, 0]);
-        for (g, (label, bars)) in panel.groups.iter().enumerate() {
-            let gx = x0 + group_gap + g as i64 * (4 * bar_w + group_gap);
-            for (b, v) in bars.iter().enumerate() {
-                let Some(v) = v.filter(|v| v.is_finite() && *v > 0.0) else {
-                    continue;
-                };
-                let bx = gx + b as i64 * bar_w;
-                rect(&mut img, bx, y_of(v), bx + bar_w - 1, base, COLORS[b % 4]);
-            }
-            let label_w = label.chars().count() as i64 * 8;
-            text(&mut img, gx + 2 * bar_w - label_w / 2, base + 5, 2, label);
+    let d0 = lo.log10().floor() as i32;
+    (d0, (hi.log10().ceil() as i32).max(d0 + 1))
+}
+
+/// `10ⁿ` for a power of ten, with the exponent in superscript digits.
+fn power_of_ten(v: f64) -> String {
+    let exponent = format!("{}", v.log10().round() as i32);
+    let sup: String = exponent
+        .chars()
+        .map(|c| match c {
+            '-' => '⁻',
+            d => ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹']
+                [d.to_digit(10).unwrap_or(0) as usize],
+        })
+        .collect();
+    format!("10{sup}")
+}
+
+/// One panel: bars of the groups over the decades `(d0, d1)`.
+fn draw_panel(
+    area: &canvas::PngArea,
+    panel: &Panel,
+    (d0, d1): (i32, i32),
+    labels: &Labels,
+) -> Result<()> {
+    let n = panel.groups.len().max(1);
+    // Just beyond the decades, so that rounding keeps both ends' labels.
+    let (lo, hi) = (0.999 * 10f64.powi(d0), 1.001 * 10f64.powi(d1));
+    let mut chart = ChartBuilder::on(area)
+        .caption(labels.title, (FONT, 16))
+        .margin(6)
+        .margin_right(12)
+        .x_label_area_size(if labels.x.is_some() { 46 } else { 26 })
+        .y_label_area_size(if labels.y.is_some() { 62 } else { 44 })
+        .build_cartesian_2d(-0.5..n as f64 - 0.5, (lo..hi).log_scale())
+        .context("drawing a panel")?;
+    let group_label = |x: &f64| {
+        let g = x.round();
+        (g >= 0.0 && (x - g).abs() < 1e-6)
+            .then(|| panel.groups.get(g as usize).map(|group| group.0.clone()))
+            .flatten()
+            .unwrap_or_default()
+    };
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(n)
+        .y_labels((d1 - d0 + 1) as usize)
+        .y_max_light_lines(0)
+        .bold_line_style(RGBColor(220, 220, 220))
+        .x_label_formatter(&group_label)
+        .y_label_formatter(&|v| power_of_ten(*v))
+        .label_style((FONT, 14))
+        .axis_desc_style((FONT, 14))
+        .x_desc(labels.x.unwrap_or(""))
+        .y_desc(labels.y.unwrap_or(""))
+        .draw()
+        .context("drawing a panel's axes")?;
+    const BAR_W: f64 = 0.2;
+    for (g, (_, bars)) in panel.groups.iter().enumerate() {
+        for (b, value) in bars.iter().enumerate() {
+            let Some(v) = value.filter(|v| v.is_finite() && *v > 0.0) else {
+                continue;
+            };
+            let x0 = g as f64 + (b as f64 - 2.0) * BAR_W;
+            chart
+                .draw_series([Rectangle::new(
+                    [(x0 + 0.01, lo), (x0 + BAR_W - 0.01, v)],
+                    COLORS[b % COLORS.len()].filled(),
+                )])
+                .context("drawing the bars")?;
         }
-        x0 += w + panel_gap;
     }
-    img.save(path)
-        .with_context(|| format!("writing {}", path.display()))
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn panels() -> Vec<Panel> {
+        let group =
+            |r: &str, v: f64| (r.to_owned(), [Some(v), Some(2.0 * v), None, Some(f64::NAN)]);
+        vec![
+            Panel {
+                groups: vec![group("0.1", 50_000.0), group("0.2", 8_000.0)],
+            },
+            Panel {
+                groups: vec![group("0.1", 3.0), group("0.2", 0.5)],
+            },
+        ]
+    }
+
+    #[test]
+    fn chart_is_written_and_decodes() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("leaves.png");
+        bar_chart(&path, "leaves", &["a", "b"], &panels()).expect("chart");
+        let image = image::open(&path).expect("decodes").to_rgb8();
+        assert_eq!(image.width(), 2 * PANEL.0);
+        assert!(image.height() > PANEL.1);
+        for color in COLORS.iter().take(2) {
+            let RGBColor(r, g, b) = *color;
+            assert!(image.pixels().any(|p| p.0 == [r, g, b]), "{color:?}");
+        }
+        // Text (tick labels, titles, legend) is drawn: dark pixels outside the bars.
+        assert!(
+            image
+                .pixels()
+                .filter(|p| p.0[0] < 60 && p.0[2] < 60)
+                .count()
+                > 500
+        );
+    }
+
+    #[test]
+    fn same_input_same_bytes() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
+        bar_chart(&a, "leaves", &["a", "b"], &panels()).expect("chart");
+        bar_chart(&b, "leaves", &["a", "b"], &panels()).expect("chart");
+        assert_eq!(std::fs::read(a).expect("a"), std::fs::read(b).expect("b"));
+    }
+
+    #[test]
+    fn decades_span_the_values() {
+        assert_eq!(decades(&panels()), (-1, 5));
+        assert_eq!(decades(&[]), (0, 1));
+        assert_eq!(power_of_ten(1e-3), "10⁻³");
+        assert_eq!(power_of_ten(100.0), "10²");
+    }
 }

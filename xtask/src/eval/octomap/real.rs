@@ -1,10 +1,10 @@
 //! The headline table: the real scans at r = 0.2 m, M = 8, beam-based, both fusion rules,
-//! built from the run rows and variant rows the main loop records.
+//! built from the JSON rows of the tables of all runs and variants.
 
 use serde_json::{Value, json};
 
 use super::EQUAL_LABEL;
-use super::data::Dataset;
+use super::measure::SetInfo;
 use crate::table::{Table, fmt_num};
 
 /// Why no row of this table is like for like with the thesis' figure.
@@ -40,7 +40,7 @@ fn ratio(v: &Value) -> String {
 }
 
 /// The table over the real data sets and its JSON rows (`summary.real`).
-pub fn table(sets: &[Dataset], rows: &[Value], variants: &[Value]) -> (Table, Vec<Value>) {
+pub fn table(sets: &[&SetInfo], rows: &[Value], variants: &[Value]) -> (Table, Vec<Value>) {
     let mut table = Table::new([
         "data (real)",
         "points",
@@ -60,7 +60,7 @@ pub fn table(sets: &[Dataset], rows: &[Value], variants: &[Value]) -> (Table, Ve
             .unwrap_or(Value::Null);
         table.row([
             set.name.clone(),
-            set.graph.num_points().to_string(),
+            set.points.to_string(),
             run["octomap"]["leaves_pruned"]
                 .to_string()
                 .replace("null", "—"),
@@ -83,7 +83,7 @@ pub fn table(sets: &[Dataset], rows: &[Value], variants: &[Value]) -> (Table, Ve
         ]);
         json_rows.push(json!({
             "data": set.name,
-            "points": set.graph.num_points(),
+            "points": set.points,
             "leaf_reduction": run["leaf_reduction"],
             "insertion_time_ratio": run["insertion_time_ratio"],
             "bytes_ratio": run["bytes_ratio"],
