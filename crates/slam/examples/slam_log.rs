@@ -8,6 +8,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use raypath_geometry::Pose2;
 use raypath_io::sequence::{PlanarOptions, pair_reference, read_planar};
 use raypath_slam::benchmark::{consecutive_relations, random_relations, relation_errors};
 use raypath_slam::{Slam, SlamConfig};
@@ -65,6 +66,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(w) = env("SLAM_REJECT") {
         config.reject_weight = w;
     }
+    if let Some(s) = env("SLAM_ODO") {
+        config.matcher.odometry_sigma = Some([s, s, env("SLAM_ODO_ROT").unwrap_or(s / 2.0)]);
+    }
     if let Some(n) = env("SLAM_NODES") {
         config.submaps.nodes_per_submap = n as usize;
     }
@@ -74,6 +78,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         slam.process(f)?;
     }
     let out = slam.finish()?;
+    if let Ok(path) = std::env::var("SLAM_TRAJ") {
+        let lines: Vec<String> = out
+            .world_from_sensor
+            .iter()
+            .zip(&frames)
+            .map(|(p, f)| {
+                let o = f.world_from_laser;
+                format!(
+                    "{} {} {} {} {} {}",
+                    p.x(),
+                    p.y(),
+                    p.theta(),
+                    o.x(),
+                    o.y(),
+                    o.theta()
+                )
+            })
+            .collect();
+        std::fs::write(path, lines.join("\n"))?;
+    }
     let secs = t0.elapsed().as_secs_f64();
     println!(
         "{} scans, {} nodes, {} submaps, {} loop closures ({} rejected) in {secs:.2} s ({:.0} scans/s)",
@@ -159,6 +183,33 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     share(&k.measured),
                     share(&k.reference()),
                     k.reference_disputed(&scans, &reference),
+                );
+                let support = |i: usize, pose: &Pose2| {
+                    raypath_slam::benchmark::reference_support(&scans, &reference, i, pose)
+                        .unwrap_or(f64::NAN)
+                };
+                let gap = |i: usize| {
+                    (0..=50)
+                        .find(|d| {
+                            [i.saturating_sub(*d), i + d]
+                                .iter()
+                                .any(|&m| reference.get(m).copied().flatten().is_some())
+                        })
+                        .unwrap_or(99)
+                };
+                let loop_scan = k.reference_near * k.measured;
+                let loop_near = k.reference_scan * k.measured.inverse();
+                println!(
+                    "    map support: near {} (gap {}) at reference {:.2}, at loop {:.2}; \
+                     scan {} (gap {}) at reference {:.2}, at loop {:.2}",
+                    k.near_scan,
+                    gap(k.near_scan),
+                    support(k.near_scan, &k.reference_near),
+                    support(k.near_scan, &loop_near),
+                    k.scan,
+                    gap(k.scan),
+                    support(k.scan, &k.reference_scan),
+                    support(k.scan, &loop_scan),
                 );
             }
         }
