@@ -48,6 +48,18 @@ pub struct EvalContext {
 }
 
 impl EvalContext {
+    /// A quick context rooted at a scratch directory `root` (tests): data under `root/data`,
+    /// outputs under `root`.
+    #[cfg(test)]
+    pub fn scratch(root: &Path) -> Self {
+        Self {
+            workspace_root: root.to_path_buf(),
+            data_dir: root.join("data"),
+            quick: true,
+            out_dir: root.to_path_buf(),
+        }
+    }
+
     /// A progress bar for `len` steps, drawn on stderr (hidden when stderr is not a terminal).
     pub fn progress(&self, len: u64, message: &str) -> ProgressBar {
         let bar = ProgressBar::new(len);

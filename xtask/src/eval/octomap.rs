@@ -378,12 +378,7 @@ mod tests {
     #[test]
     fn report_from_known_measurements() {
         let dir = tempfile::tempdir().unwrap();
-        let ctx = EvalContext {
-            workspace_root: dir.path().to_path_buf(),
-            data_dir: dir.path().join("data"),
-            quick: true,
-            out_dir: dir.path().to_path_buf(),
-        };
+        let ctx = EvalContext::scratch(dir.path());
         let absent = serde_json::to_value(SetResult {
             set: None,
             octomap_unavailable: None,

@@ -274,12 +274,7 @@ mod tests {
     #[test]
     fn report_from_known_results() {
         let dir = tempfile::tempdir().unwrap();
-        let ctx = EvalContext {
-            workspace_root: dir.path().to_path_buf(),
-            data_dir: dir.path().join("data"),
-            quick: true,
-            out_dir: dir.path().to_path_buf(),
-        };
+        let ctx = EvalContext::scratch(dir.path());
         let log = UnitResult {
             log: Some(("intel".to_owned(), 2, 180)),
             rays: 2 * 180,

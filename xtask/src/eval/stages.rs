@@ -242,12 +242,7 @@ mod tests {
     use super::*;
 
     fn ctx(root: &Path) -> EvalContext {
-        EvalContext {
-            workspace_root: root.to_path_buf(),
-            data_dir: root.join("data"),
-            quick: true,
-            out_dir: root.to_path_buf(),
-        }
+        EvalContext::scratch(root)
     }
 
     fn units(_: &EvalContext) -> Result<Vec<String>> {
