@@ -2,6 +2,10 @@
 //! organized scan of a box room with 2 cm radial noise (synthetic, so it runs without data),
 //! and PPE and the PEAC-style baseline on the first generated SynPEB-style scan (σ = 2 cm)
 //! when `cargo xtask datasets generate` has written it.
+//!
+//! To compare two versions: `cargo bench -p raypath-planes --bench ppe -- --save-baseline
+//! before` on the first, `cargo bench -p raypath-planes --bench ppe -- --baseline before` on
+//! the second (the PEAC-style baseline, unchanged by PPE work, shows the machine's drift).
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use criterion::{Criterion, criterion_group, criterion_main};

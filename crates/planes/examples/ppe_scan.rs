@@ -1,6 +1,10 @@
 //! Runs PPE on SynPEB-style PCD files and prints the Hoover metrics.
 //!
-//! `cargo run --release -p raypath-planes --example ppe_scan -- FILE.pcd… [--e E] [--lmax D]`
+//! `cargo run --release -p raypath-planes --example ppe_scan -- FILE.pcd… [--e E] [--lmax D]
+//! [--refine R] [--min M] [--peac INIT,MERGE,MIN,DISC,SIG] [--hash]`
+//!
+//! `--hash` adds a fingerprint of each segmentation (FNV-1a of the labels, the step count
+//! and id-weighted sums of the plane parameters) to compare two builds of PPE.
 
 use std::time::Instant;
 
@@ -11,6 +15,7 @@ fn main() {
     let mut params = PpeParams::synpeb();
     let mut peac_params: Option<PeacParams> = None;
     let mut files = Vec::new();
+    let mut hash = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -55,6 +60,7 @@ fn main() {
                 }
                 peac_params = Some(p);
             }
+            "--hash" => hash = true,
             _ => files.push(a),
         }
     }
@@ -123,6 +129,9 @@ fn main() {
             h.gt_regions,
             secs
         );
+        if hash {
+            println!("{f}: {}", fingerprint(&seg));
+        }
     }
     let n = sums[0].max(1.0);
     println!(
@@ -136,4 +145,25 @@ fn main() {
         sums[6] / n,
         sums[7] / n
     );
+}
+
+/// FNV-1a of the labels, the step count and id-weighted sums of the plane parameters.
+fn fingerprint(seg: &raypath_planes::Segmentation) -> String {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for l in &seg.labels {
+        for byte in l.unwrap_or(u32::MAX).to_le_bytes() {
+            h = (h ^ u64::from(byte)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    let w_sum: f64 = seg
+        .planes
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (i + 1) as f64 * (p.fit.w.x + 2.0 * p.fit.w.y + 3.0 * p.fit.w.z))
+        .sum();
+    format!(
+        "labels {h:016x} steps {} w_sum {w_sum:.12e} sse {:.12e}",
+        seg.steps,
+        seg.sse()
+    )
 }

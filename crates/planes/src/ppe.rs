@@ -13,10 +13,19 @@
 //! they were queued: a popped candidate is re-evaluated for the current planes and executed
 //! if its increment is still no larger than the next key, else queued again; so only the
 //! candidates at the front of the queue are ever recomputed. A final pass re-evaluates
-//! every queued candidate before stopping (stale keys are not lower bounds).
+//! every queued candidate before stopping (stale keys are not lower bounds). Equal
+//! increments are frequent (the radial error of four rays often vanishes to machine
+//! precision and clamps at 0), so their order is fixed: merges before extensions before
+//! creations; creations by ray index; extensions and merges by their plane and ray ids
+//! under a fixed bijection that scatters neighbouring ids (in plain index order, their
+//! ties favoured one side of the image and raised the plane RMSE on real KITTI frames).
+//! The order of the pops is then a
+//! function of the queued set, independent of the queue's layout (`ppe/queue.rs`).
 //!
 //! Merge candidates are queued once per pair of planes (again only with a smaller key),
-//! which keeps the queue near the number of boundary rays.
+//! which keeps the queue near the number of boundary rays. A creation candidate stays valid
+//! while the cells of its tetromino are atomic: rays only ever join planes, so the set of
+//! tetrominoes of a ray only shrinks and its best one stays the best.
 //!
 //! Optional post-processing ([`PpeParams::refine_rounds`], not in the thesis): each round
 //! (1) moves every ray on a plane boundary to the adjacent plane with the least radial
@@ -25,27 +34,47 @@
 //! column, only rays in front of the joint plane of `a` and `b` follow, then `b` begins —
 //! while the increment stays within `e`. Each round costs O(K) plus the merges.
 //!
-//! Cost: seeding evaluates 17 tetrominoes per ray (parallel, rayon); every action costs
-//! O(1) solves plus O(log Q) queue operations; a merge relabels the smaller plane
-//! (O(K log K) relabelling in total). Final exact refits are O(K · iterations).
-//! Each increment costs one 3 × 3 solve on the additive statistics of
-//! [`crate::PlaneStats`]; the planes of the result are refitted on the exact radial
-//! residuals ([`crate::fit::refine`]).
-
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
+//! Cost: seeding evaluates 17 tetrominoes per ray (parallel over rows, rayon), each a
+//! bit test on the ray's 3 × 3 neighbourhood and, when valid, one 3 × 3 solve; every action
+//! costs O(1) solves plus O(log Q) queue operations on 16-byte entries (bucketed by the
+//! key's exponent, so a pop touches a small heap); a merge relabels the smaller plane and
+//! splices its member list (O(K log K) relabelling in total). Final exact refits are
+//! O(K · iterations), parallel over planes. Each increment costs one 3 × 3 solve on the
+//! additive statistics of [`crate::PlaneStats`] (computed from the endpoints when needed);
+//! the planes of the result are refitted on the exact radial residuals
+//! ([`crate::fit::refine`]).
+//!
+//! Storage is contiguous: per ray its link bits, neighbourhood links, label, queued
+//! extension, the next member of its plane (planes are intrusive lists) and one bit
+//! "atomic"; per plane its statistics, error, list ends and parent (union by size).
 
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use raypath_geometry::PointCloud;
 
 use crate::error::PlaneError;
-use crate::fit::{PlaneFit, refine};
+use crate::fit::PlaneFit;
 use crate::params::PpeParams;
-use crate::stats::PlaneStats;
+use crate::stats::Moments;
 use crate::tetromino::TETROMINOES;
 
+mod grid;
+mod polish;
+mod queue;
+
 const NONE: u32 = u32::MAX;
+/// Rays and planes are packed into 31 bits in the queue.
+const MAX_RAYS: usize = 1 << 31;
+const ID_MASK: u64 = (1 << 31) - 1;
+
+/// One bit per ray, set where `bits` is true.
+fn bitset(bits: &[bool]) -> Vec<u64> {
+    let mut out = vec![0u64; bits.len().div_ceil(64)];
+    for (k, _) in bits.iter().enumerate().filter(|(_, b)| **b) {
+        out[k / 64] |= 1 << (k % 64);
+    }
+    out
+}
 
 /// One extracted plane.
 #[derive(Debug, Clone, PartialEq)]
@@ -120,7 +149,7 @@ pub fn extract_grid(
 ) -> Result<Segmentation, PlaneError> {
     params.validate()?;
     PlaneError::check_organized(width, height, points.len())?;
-    if points.len() >= NONE as usize {
+    if points.len() >= MAX_RAYS {
         return Err(PlaneError::Parameter {
             name: "points",
             reason: "too many rays".into(),
@@ -149,38 +178,108 @@ enum Action {
     },
 }
 
+/// A bijection of 31-bit ids that scatters neighbouring ids ([`unscramble`] inverts it).
+fn scramble(x: u32) -> u32 {
+    let mut x = u64::from(x);
+    x = (x * 0x5bd1_e995) & ID_MASK;
+    x ^= x >> 16;
+    x = (x * 0x2c1b_3c6d) & ID_MASK;
+    x ^= x >> 15;
+    x as u32
+}
+
+/// The inverse of [`scramble`].
+fn unscramble(x: u32) -> u32 {
+    let mut x = u64::from(x);
+    x ^= (x >> 15) ^ (x >> 30);
+    x = (x * inverse(0x2c1b_3c6d)) & ID_MASK;
+    x ^= x >> 16;
+    x = (x * inverse(0x5bd1_e995)) & ID_MASK;
+    x as u32
+}
+
+/// The inverse of odd `a` modulo 2^31 (Newton's iteration).
+const fn inverse(a: u64) -> u64 {
+    let mut x = a;
+    let mut i = 0;
+    while i < 5 {
+        x = x.wrapping_mul(2u64.wrapping_sub(a.wrapping_mul(x)));
+        i += 1;
+    }
+    x & ID_MASK
+}
+
+impl Action {
+    /// Two bits of kind and two 31-bit ids, ordered as ties are broken (module docs).
+    fn pack(self) -> u64 {
+        let (kind, hi, lo) = match self {
+            Action::Create { point, mask } => (2, point, u32::from(mask)),
+            Action::Extend { plane, point } => (1, scramble(plane), scramble(point)),
+            Action::Merge { a, b } => (0, scramble(a), scramble(b)),
+        };
+        (kind << 62) | (u64::from(hi) << 31) | u64::from(lo)
+    }
+
+    fn unpack(bits: u64) -> Self {
+        let hi = ((bits >> 31) & ID_MASK) as u32;
+        let lo = (bits & ID_MASK) as u32;
+        match bits >> 62 {
+            2 => Action::Create {
+                point: hi,
+                mask: lo as u8,
+            },
+            1 => Action::Extend {
+                plane: unscramble(hi),
+                point: unscramble(lo),
+            },
+            _ => Action::Merge {
+                a: unscramble(hi),
+                b: unscramble(lo),
+            },
+        }
+    }
+}
+
+/// A candidate: its increment and its packed [`Action`]. Candidates are ordered by
+/// increment, ties by the packed action (see the module docs).
 #[derive(Debug, Clone, Copy)]
 struct Entry {
     key: f64,
-    action: Action,
+    action: u64,
 }
 
-impl PartialEq for Entry {
-    fn eq(&self, other: &Self) -> bool {
-        self.key.total_cmp(&other.key) == Ordering::Equal
+impl Entry {
+    fn new(key: f64, action: Action) -> Self {
+        Self {
+            key,
+            action: action.pack(),
+        }
     }
-}
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
+
+    fn action(&self) -> Action {
+        Action::unpack(self.action)
     }
-}
-impl Ord for Entry {
-    // Reversed: BinaryHeap is a max-heap, we pop the least increment.
-    fn cmp(&self, other: &Self) -> Ordering {
-        other.key.total_cmp(&self.key)
+
+    /// The queue's 16-byte form, ordered as the candidates.
+    fn item(&self) -> queue::Item {
+        queue::item(self.key, self.action)
+    }
+
+    fn from_item(item: queue::Item) -> Self {
+        let (key, action) = queue::split(item);
+        Self { key, action }
     }
 }
 
+/// A plane: its additive statistics, their error (Eq. 11.2) and its member list.
 struct Cluster {
-    stats: PlaneStats,
+    stats: Moments,
     error: f64,
-    members: Vec<u32>,
-    parent: u32,
-    /// Partners of the merge candidates queued for this plane, with the least queued key:
-    /// a merge is queued again only with a smaller key (keeps the heap small).
-    queued: Vec<(u32, f64)>,
+    /// First and last member ray (`NONE` when empty) and the number of members; the
+    /// members are chained by `State::next`.
+    head: u32,
+    tail: u32,
+    len: u32,
 }
 
 struct State<'a> {
@@ -189,20 +288,25 @@ struct State<'a> {
     height: usize,
     params: &'a PpeParams,
     valid: Vec<bool>,
-    /// Statistics of every ray (zero for no-returns).
-    point_stats: Vec<PlaneStats>,
-    /// Edge (k, k + 1) usable.
-    right: Vec<bool>,
-    /// Edge (k, k + width) usable.
-    down: Vec<bool>,
+    /// Link bits of every ray ([`grid::UP`] … [`grid::RIGHT`]): neighbours it may join.
+    links: Vec<u8>,
+    /// The links inside the 3 × 3 neighbourhood of every ray ([`grid::edges`]).
+    edges: Vec<u16>,
     label: Vec<u32>,
+    /// One bit per ray: a valid ray that is still atomic (cache-resident, unlike `label`).
+    free: Vec<u64>,
+    /// The next member of the ray's plane (`NONE`: last).
+    next: Vec<u32>,
     /// Plane of the queued extension of each atomic ray (`NONE`: none queued).
     pending: Vec<u32>,
     clusters: Vec<Cluster>,
-    heap: BinaryHeap<Entry>,
-    /// The initial creation candidates, ascending by key, consumed from `next_create`
+    /// The plane each plane was merged into (itself while it is a root).
+    parent: Vec<u32>,
+    queued: queue::Queued,
+    heap: queue::Queue,
+    /// The initial creation candidates in ascending order, consumed from `next_create`
     /// (kept out of the heap: most are void by the time they come up).
-    creates: Vec<Entry>,
+    creates: Vec<queue::Item>,
     next_create: usize,
     plane_count: usize,
     steps: usize,
@@ -215,28 +319,13 @@ impl<'a> State<'a> {
             .map(|p| p.iter().all(|x| x.is_finite()) && p.norm_squared() > 0.0)
             .collect();
         let n = points.len();
-        let mut right = vec![false; n];
-        let mut down = vec![false; n];
-        for k in 0..n {
-            let col = k % width;
-            if col + 1 < width && valid[k] && valid[k + 1] {
-                right[k] = (points[k] - points[k + 1]).norm() <= params.l_max_m;
-            }
-            if k + width < n && valid[k] && valid[k + width] {
-                down[k] = (points[k] - points[k + width]).norm() <= params.l_max_m;
-            }
-        }
+        let links = grid::links(&valid, points, width, params.l_max_m);
         let plane_count = valid.iter().filter(|&&v| v).count();
-        let point_stats = points
-            .iter()
-            .zip(&valid)
-            .map(|(p, &ok)| {
-                if ok {
-                    PlaneStats::of_point(p)
-                } else {
-                    PlaneStats::default()
-                }
-            })
+        let free = bitset(&valid);
+        let size = (width, height);
+        let edges = (0..n)
+            .into_par_iter()
+            .map(|k| grid::edges(k, size, &links))
             .collect();
         let mut s = Self {
             points,
@@ -244,127 +333,148 @@ impl<'a> State<'a> {
             height,
             params,
             valid,
-            point_stats,
-            right,
-            down,
+            links,
+            edges,
             label: vec![NONE; n],
+            free,
+            next: vec![NONE; n],
             pending: vec![NONE; n],
             clusters: Vec::new(),
-            heap: BinaryHeap::new(),
+            parent: Vec::new(),
+            queued: queue::Queued::default(),
+            heap: queue::Queue::default(),
             creates: Vec::new(),
             next_create: 0,
             plane_count,
             steps: 0,
         };
-        let chunk = n
-            .div_ceil(rayon::current_num_threads().max(1) * 8)
-            .max(1024);
-        let mut entries: Vec<Entry> = (0..n)
-            .into_par_iter()
-            .with_min_len(chunk)
-            .filter_map(|k| {
-                s.best_create(k).map(|(key, mask)| Entry {
-                    key,
-                    action: Action::Create {
-                        point: k as u32,
-                        mask,
-                    },
-                })
-            })
-            .collect();
-        entries.par_sort_unstable_by(|a, b| a.key.total_cmp(&b.key));
-        s.creates = entries;
+        s.creates = s.seed();
         s
     }
 
-    fn cell(&self, k: usize, d: (i8, i8)) -> Option<usize> {
-        let row = (k / self.width) as isize + d.0 as isize;
-        let col = (k % self.width) as isize + d.1 as isize;
-        (row >= 0 && col >= 0 && (row as usize) < self.height && (col as usize) < self.width)
-            .then(|| row as usize * self.width + col as usize)
-    }
-
-    /// Whether 4-adjacent cells `a`, `b` may be joined.
-    fn edge(&self, a: usize, b: usize) -> bool {
-        let (lo, hi) = if a < b { (a, b) } else { (b, a) };
-        if hi == lo + 1 && hi % self.width != 0 {
-            self.right[lo]
-        } else if hi == lo + self.width {
-            self.down[lo]
-        } else {
-            false
-        }
+    /// The best tetromino of every ray, ascending by `e_crt` (Eq. 11.4); rows in parallel.
+    fn seed(&self) -> Vec<queue::Item> {
+        let mut entries: Vec<queue::Item> = (0..self.height)
+            .into_par_iter()
+            .flat_map_iter(|row| {
+                (row * self.width..(row + 1) * self.width).filter_map(move |k| {
+                    let (key, mask) = self.best_create(k)?;
+                    let point = k as u32;
+                    Some(Entry::new(key, Action::Create { point, mask }).item())
+                })
+            })
+            .collect();
+        entries.par_sort_unstable();
+        entries
     }
 
     /// The cells of tetromino `mask` around `k` if all are atomic, valid and connected.
     fn tetromino(&self, k: usize, mask: usize) -> Option<[usize; 4]> {
-        let offsets = TETROMINOES.get(mask)?;
-        let mut cells = [k; 4];
-        for (slot, d) in cells.iter_mut().skip(1).zip(offsets) {
-            *slot = self.cell(k, *d)?;
-        }
-        if cells
-            .iter()
-            .any(|&c| !self.valid[c] || self.label[c] != NONE)
-        {
+        let &(need_cells, need_edges) = grid::SHAPES.get(mask)?;
+        let (cells, edges) = (self.cells(k), self.edges[k]);
+        if cells & need_cells != need_cells || edges & need_edges != need_edges {
             return None;
         }
-        for i in 0..4 {
-            for j in i + 1..4 {
-                let (a, b) = (cells[i], cells[j]);
-                let adjacent = a.abs_diff(b) == self.width
-                    || (a.abs_diff(b) == 1 && a / self.width == b / self.width);
-                if adjacent && !self.edge(a, b) {
-                    return None;
-                }
-            }
-        }
-        Some(cells)
+        Some(self.tetromino_cells(k, mask))
     }
 
-    fn tetromino_stats(&self, cells: &[usize; 4]) -> PlaneStats {
-        let mut s = PlaneStats::default();
+    /// The cells of tetromino `mask` around `k`, `k` first (all must exist).
+    fn tetromino_cells(&self, k: usize, mask: usize) -> [usize; 4] {
+        let o = TETROMINOES[mask];
+        let w = self.width;
+        [
+            k,
+            grid::offset(k, w, o[0]),
+            grid::offset(k, w, o[1]),
+            grid::offset(k, w, o[2]),
+        ]
+    }
+
+    /// The atomic valid cells of the 3 × 3 neighbourhood of `k` ([`grid::cells`]).
+    fn cells(&self, k: usize) -> u16 {
+        grid::cells(k, (self.width, self.height), |c| self.is_free(c))
+    }
+
+    /// The statistics of ray `k` (computed when needed: 24 bytes of endpoint are cheaper to
+    /// load than 88 bytes of statistics).
+    fn ray_stats(&self, k: usize) -> Moments {
+        Moments::of_point(&self.points[k])
+    }
+
+    fn tetromino_stats(&self, cells: &[usize; 4]) -> Moments {
+        let mut s = Moments::default();
         for &c in cells {
-            s.add(&self.point_stats[c]);
+            s.add(&self.ray_stats(c));
         }
         s
     }
 
+    /// The tetromino of atomic ray `k` with the least error `e_crt` (Eq. 11.4).
     fn best_create(&self, k: usize) -> Option<(f64, u8)> {
-        if !self.valid[k] || self.label[k] != NONE {
+        if !self.is_free(k) {
             return None;
         }
+        self.best_create_in(k, self.cells(k))
+    }
+
+    /// [`State::best_create`] for the atomic valid cells `cells` around `k`.
+    fn best_create_in(&self, k: usize, cells: u16) -> Option<(f64, u8)> {
+        let edges = self.edges[k];
+        // Statistics of the 3 × 3 neighbourhood, row-major.
+        let mut around = [Moments::default(); 9];
+        for (i, m) in around.iter_mut().enumerate() {
+            if cells & (1 << i) != 0 {
+                let d = (i as i8 / 3 - 1, i as i8 % 3 - 1);
+                *m = self.ray_stats(grid::offset(k, self.width, d));
+            }
+        }
         let mut best: Option<(f64, u8)> = None;
-        for mask in 0..TETROMINOES.len() {
-            if let Some(cells) = self.tetromino(k, mask) {
-                let e = self.tetromino_stats(&cells).error();
-                if e.is_finite() && best.is_none_or(|(b, _)| e < b) {
-                    best = Some((e, mask as u8));
-                }
+        for (mask, &(need_cells, need_edges)) in grid::SHAPES.iter().enumerate() {
+            if cells & need_cells != need_cells || edges & need_edges != need_edges {
+                continue;
+            }
+            // e_crt (Eq. 11.4), summed in the order k, then the offsets of the tetromino.
+            let mut stats = Moments::default();
+            stats.add(&around[4]);
+            for d in TETROMINOES[mask] {
+                stats.add(&around[((d.0 + 1) * 3 + d.1 + 1) as usize]);
+            }
+            let e = stats.error();
+            if e.is_finite() && best.is_none_or(|(b, _)| e < b) {
+                best = Some((e, mask as u8));
             }
         }
         best
     }
 
+    /// Whether ray `k` is valid and still atomic.
+    fn is_free(&self, k: usize) -> bool {
+        self.free[k / 64] & (1 << (k % 64)) != 0
+    }
+
+    /// Marks ray `k` as joined to a plane.
+    fn take(&mut self, k: usize) {
+        self.free[k / 64] &= !(1 << (k % 64));
+    }
+
     fn root(&self, mut c: u32) -> u32 {
-        while let Some(cl) = self.clusters.get(c as usize) {
-            if cl.parent == c {
+        while let Some(&p) = self.parent.get(c as usize) {
+            if p == c {
                 break;
             }
-            c = cl.parent;
+            c = p;
         }
         c
     }
 
+    /// `e_ext` of adding ray `point` to `plane` (Eq. 11.3).
     fn ext_increment(&self, plane: u32, point: usize) -> f64 {
         let cl = &self.clusters[plane as usize];
-        let e = cl
-            .stats
-            .union(&PlaneStats::of_point(&self.points[point]))
-            .error();
+        let e = cl.stats.union(&self.ray_stats(point)).error();
         (e - cl.error).max(0.0)
     }
 
+    /// `e_mrg` of joining planes `a` and `b` (Eq. 11.3).
     fn mrg_increment(&self, a: u32, b: u32) -> f64 {
         let (ca, cb) = (&self.clusters[a as usize], &self.clusters[b as usize]);
         let e = ca.stats.union(&cb.stats).error();
@@ -373,10 +483,9 @@ impl<'a> State<'a> {
 
     /// Queues the extensions and mergers made possible by ray `k` joining `plane`.
     fn push_neighbours(&mut self, plane: u32, k: usize) {
-        let neighbours = [(-1i8, 0i8), (1, 0), (0, -1), (0, 1)];
-        for d in neighbours {
-            let Some(o) = self.cell(k, d) else { continue };
-            if !self.edge(k, o) {
+        let links = self.links[k];
+        for (bit, o) in grid::neighbours(k, self.width) {
+            if links & bit == 0 {
                 continue;
             }
             let lo = self.label[o];
@@ -387,74 +496,61 @@ impl<'a> State<'a> {
                 let key = self.ext_increment(plane, o);
                 if key.is_finite() {
                     self.pending[o] = plane;
-                    let action = Action::Extend {
-                        plane,
-                        point: o as u32,
-                    };
-                    self.heap.push(Entry { key, action });
+                    let point = o as u32;
+                    let entry = Entry::new(key, Action::Extend { plane, point });
+                    self.heap.push(entry.item());
                 }
             } else if lo != plane {
-                let queued = self.clusters[plane as usize]
-                    .queued
-                    .iter()
-                    .find(|q| q.0 == lo)
-                    .map(|q| q.1);
                 let key = self.mrg_increment(plane, lo);
-                if key.is_finite() && queued.is_none_or(|q| key < q) {
-                    self.queue_merge(plane, lo, key);
+                if key.is_finite() && self.queued.lower(plane, lo, key) {
+                    let entry = Entry::new(key, Action::Merge { a: plane, b: lo });
+                    self.heap.push(entry.item());
                 }
             }
         }
     }
 
-    /// Queues the merge of planes `a` and `b` with `key` and records it on both.
-    fn queue_merge(&mut self, a: u32, b: u32, key: f64) {
-        for (x, y) in [(a, b), (b, a)] {
-            let list = &mut self.clusters[x as usize].queued;
-            match list.iter_mut().find(|q| q.0 == y) {
-                Some(q) => q.1 = q.1.min(key),
-                None => list.push((y, key)),
+    /// Settles the record of popped merge `popped` ([`queue::Queued`]): forgets it, and
+    /// records `again` (re-keyed, to be queued again) if given.
+    fn unqueue_merge(&mut self, popped: (u32, u32), again: Option<(u32, u32, f64)>) {
+        match again {
+            Some((a, b, key)) if queue::Queued::same(popped, (a, b)) => {
+                self.queued.set(a, b, key);
             }
-        }
-        self.heap.push(Entry {
-            key,
-            action: Action::Merge { a, b },
-        });
-    }
-
-    /// Forgets the queued merge of `a` and `b` (popped from the heap).
-    fn unqueue_merge(&mut self, a: u32, b: u32) {
-        for (x, y) in [(a, b), (b, a)] {
-            if let Some(cl) = self.clusters.get_mut(x as usize) {
-                cl.queued.retain(|q| q.0 != y);
+            Some((a, b, key)) => {
+                self.queued.remove(popped.0, popped.1);
+                self.queued.lower(a, b, key);
             }
+            None => self.queued.remove(popped.0, popped.1),
         }
     }
 
     /// The least key queued in the heap or the sorted creates.
     fn peek_key(&self) -> Option<f64> {
-        let h = self.heap.peek().map(|e| e.key);
-        let c = self.creates.get(self.next_create).map(|e| e.key);
-        match (h, c) {
-            (Some(h), Some(c)) => Some(h.min(c)),
-            (h, c) => h.or(c),
-        }
+        let h = self.heap.peek();
+        let c = self.creates.get(self.next_create).copied();
+        let least = match (h, c) {
+            (Some(h), Some(c)) => h.min(c),
+            (h, c) => h.or(c)?,
+        };
+        Some(Entry::from_item(least).key)
     }
 
     /// Pops the least entry of the heap and the sorted creates.
     fn pop(&mut self) -> Option<Entry> {
         let c = self.creates.get(self.next_create).copied();
-        match (self.heap.peek(), c) {
-            (Some(h), Some(c)) if c.key < h.key => {
+        let item = match (self.heap.peek(), c) {
+            (Some(h), Some(c)) if c < h => {
                 self.next_create += 1;
-                Some(c)
+                c
             }
             (None, Some(c)) => {
                 self.next_create += 1;
-                Some(c)
+                c
             }
-            _ => self.heap.pop(),
-        }
+            _ => self.heap.pop()?,
+        };
+        Some(Entry::from_item(item))
     }
 
     fn stop(&self, key: f64) -> bool {
@@ -476,12 +572,12 @@ impl<'a> State<'a> {
             if self.plane_limit_reached() {
                 return;
             }
-            let mut old = std::mem::take(&mut self.heap).into_vec();
+            let mut old = self.heap.take_all();
             old.extend(self.creates.drain(self.next_create..));
             self.next_create = 0;
             let mut fresh = Vec::new();
-            for entry in old {
-                if let Some(e) = self.reevaluate(entry)
+            for item in old {
+                if let Some(e) = self.reevaluate(Entry::from_item(item))
                     && e.key <= self.params.max_increment_m2
                 {
                     fresh.push(e);
@@ -490,111 +586,136 @@ impl<'a> State<'a> {
             if fresh.is_empty() {
                 return;
             }
-            for cl in &mut self.clusters {
-                cl.queued.clear();
-            }
+            self.queued.clear();
             for e in &fresh {
-                if let Action::Merge { a, b } = e.action {
-                    for (x, y) in [(a, b), (b, a)] {
-                        self.clusters[x as usize].queued.push((y, e.key));
-                    }
+                if let Action::Merge { a, b } = e.action() {
+                    self.queued.lower(a, b, e.key);
                 }
             }
-            self.heap = BinaryHeap::from(fresh);
+            for e in fresh {
+                self.heap.push(e.item());
+            }
         }
     }
 
     /// The entry re-keyed for the current planes (`None` when it is void).
     fn reevaluate(&self, entry: Entry) -> Option<Entry> {
-        match entry.action {
-            Action::Create { point, .. } => {
-                let (key, mask) = self.best_create(point as usize)?;
-                Some(Entry {
-                    key,
-                    action: Action::Create { point, mask },
-                })
+        let (key, action) = match entry.action() {
+            Action::Create { point, mask } => {
+                let k = point as usize;
+                if !self.is_free(k) {
+                    return None;
+                }
+                let cells = self.cells(k);
+                let (need, _) = grid::SHAPES[mask as usize];
+                if cells & need == need {
+                    // The candidates only shrink as rays join planes: the best is still
+                    // the best while its own cells are atomic.
+                    return Some(entry);
+                }
+                let (key, mask) = self.best_create_in(k, cells)?;
+                (key, Action::Create { point, mask })
             }
             Action::Extend { plane, point } => {
-                if self.label[point as usize] != NONE {
+                if !self.is_free(point as usize) {
                     return None;
                 }
-                let r = self.root(plane);
-                let key = self.ext_increment(r, point as usize);
-                key.is_finite().then_some(Entry {
-                    key,
-                    action: Action::Extend { plane: r, point },
-                })
+                let plane = self.root(plane);
+                let key = self.ext_increment(plane, point as usize);
+                (key, Action::Extend { plane, point })
             }
             Action::Merge { a, b } => {
-                let (ra, rb) = (self.root(a), self.root(b));
-                if ra == rb {
+                let (a, b) = (self.root(a), self.root(b));
+                if a == b {
                     return None;
                 }
-                let key = self.mrg_increment(ra, rb);
-                key.is_finite().then_some(Entry {
-                    key,
-                    action: Action::Merge { a: ra, b: rb },
-                })
+                (self.mrg_increment(a, b), Action::Merge { a, b })
+            }
+        };
+        key.is_finite().then(|| Entry::new(key, action))
+    }
+
+    /// Lazy greedy loop (Algorithm 2): a popped candidate is re-evaluated for the current
+    /// planes; it is executed when its current increment is still no larger than the next
+    /// queued key, otherwise queued again with the new key.
+    fn run_until_stop(&mut self) {
+        while let Some(entry) = self.pop() {
+            if self.plane_limit_reached() || !self.step(entry) {
+                break;
             }
         }
     }
 
-    /// Lazy greedy loop: a popped candidate is re-evaluated for the current planes; it is
-    /// executed when its current increment is still no larger than the next queued key,
-    /// otherwise queued again with the new key.
-    fn run_until_stop(&mut self) {
-        while let Some(entry) = self.pop() {
-            if self.plane_limit_reached() {
-                break;
+    /// Handles popped candidate `entry`; returns `false` when the clustering stops (the
+    /// least increment exceeds `e`, Eq. 11.3, or the plane limit is reached).
+    fn step(&mut self, entry: Entry) -> bool {
+        let popped_merge = match entry.action() {
+            Action::Extend { point, .. } => {
+                self.pending[point as usize] = NONE;
+                None
             }
-            match entry.action {
-                Action::Extend { point, .. } => self.pending[point as usize] = NONE,
-                Action::Merge { a, b } => self.unqueue_merge(a, b),
-                Action::Create { .. } => {}
+            Action::Merge { a, b } => Some((a, b)),
+            Action::Create { .. } => None,
+        };
+        let Some(current) = self.reevaluate(entry) else {
+            if let Some(popped) = popped_merge {
+                self.unqueue_merge(popped, None);
             }
-            let Some(current) = self.reevaluate(entry) else {
-                continue;
+            return true;
+        };
+        let action = current.action();
+        if let Action::Extend { plane, point } = action {
+            self.pending[point as usize] = plane;
+        }
+        let still_least =
+            current.key <= entry.key || self.peek_key().is_none_or(|next| current.key <= next);
+        let stop = still_least && self.stop(current.key);
+        let requeue = !still_least || stop;
+        if let Some(popped) = popped_merge {
+            let again = match action {
+                Action::Merge { a, b } if requeue => Some((a, b, current.key)),
+                _ => None,
             };
-            if let Action::Extend { plane, point } = current.action {
-                self.pending[point as usize] = plane;
-            }
-            let still_least =
-                current.key <= entry.key || self.peek_key().is_none_or(|next| current.key <= next);
-            let stop = still_least && self.stop(current.key);
-            if !still_least || stop {
-                match current.action {
-                    Action::Merge { a, b } => self.queue_merge(a, b, current.key),
-                    _ => self.heap.push(current),
+            self.unqueue_merge(popped, again);
+        }
+        if requeue {
+            self.heap.push(current.item());
+        } else {
+            self.execute(action);
+        }
+        !stop
+    }
+
+    fn execute(&mut self, action: Action) {
+        match action {
+            Action::Create { point, mask } => {
+                if let Some(cells) = self.tetromino(point as usize, mask as usize) {
+                    self.create(cells);
                 }
-                if stop {
-                    break;
-                }
-                continue;
             }
-            match current.action {
-                Action::Create { point, mask } => {
-                    if let Some(cells) = self.tetromino(point as usize, mask as usize) {
-                        self.create(cells);
-                    }
-                }
-                Action::Extend { plane, point } => self.extend(plane, point as usize),
-                Action::Merge { a, b } => self.merge(a, b),
-            }
+            Action::Extend { plane, point } => self.extend(plane, point as usize),
+            Action::Merge { a, b } => self.merge(a, b),
         }
     }
 
     fn create(&mut self, cells: [usize; 4]) {
         let id = self.clusters.len() as u32;
         let stats = self.tetromino_stats(&cells);
+        for pair in cells.windows(2) {
+            self.next[pair[0]] = pair[1] as u32;
+        }
+        self.next[cells[3]] = NONE;
         self.clusters.push(Cluster {
             stats,
             error: stats.error(),
-            members: cells.iter().map(|&c| c as u32).collect(),
-            parent: id,
-            queued: Vec::new(),
+            head: cells[0] as u32,
+            tail: cells[3] as u32,
+            len: 4,
         });
+        self.parent.push(id);
         for &c in &cells {
             self.label[c] = id;
+            self.take(c);
         }
         self.plane_count -= 3;
         self.steps += 1;
@@ -603,319 +724,112 @@ impl<'a> State<'a> {
         }
     }
 
+    /// Appends ray `k` to the member list of `plane`.
+    fn append(&mut self, plane: u32, k: usize) {
+        let cl = &mut self.clusters[plane as usize];
+        if cl.len == 0 {
+            cl.head = k as u32;
+        } else {
+            self.next[cl.tail as usize] = k as u32;
+        }
+        cl.tail = k as u32;
+        cl.len += 1;
+        self.next[k] = NONE;
+    }
+
     fn extend(&mut self, plane: u32, k: usize) {
-        let add = self.point_stats[k];
+        let add = self.ray_stats(k);
         let cl = &mut self.clusters[plane as usize];
         cl.stats.add(&add);
         cl.error = cl.stats.error();
-        cl.members.push(k as u32);
+        self.append(plane, k);
         self.label[k] = plane;
+        self.take(k);
         self.plane_count -= 1;
         self.steps += 1;
         self.push_neighbours(plane, k);
     }
 
+    /// Merges planes `a` and `b`: the smaller one (by rays) is relabelled and its member
+    /// list spliced onto the larger one's (union by size).
     fn merge(&mut self, a: u32, b: u32) {
-        let (big, small) =
-            if self.clusters[a as usize].members.len() >= self.clusters[b as usize].members.len() {
-                (a, b)
-            } else {
-                (b, a)
-            };
-        let moved = std::mem::take(&mut self.clusters[small as usize].members);
-        let small_stats = self.clusters[small as usize].stats;
-        for &m in &moved {
+        let (big, small) = if self.clusters[a as usize].len >= self.clusters[b as usize].len {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        let s = &self.clusters[small as usize];
+        let (small_stats, head, tail, len) = (s.stats, s.head, s.tail, s.len);
+        let mut m = head;
+        for _ in 0..len {
             self.label[m as usize] = big;
+            m = self.next[m as usize];
         }
-        self.clusters[small as usize].parent = big;
+        let s = &mut self.clusters[small as usize];
+        (s.head, s.tail, s.len) = (NONE, NONE, 0);
+        self.parent[small as usize] = big;
+        if len > 0 {
+            let cl = &self.clusters[big as usize];
+            if cl.len == 0 {
+                self.clusters[big as usize].head = head;
+            } else {
+                self.next[cl.tail as usize] = head;
+            }
+            self.clusters[big as usize].tail = tail;
+        }
         let cl = &mut self.clusters[big as usize];
+        cl.len += len;
         cl.stats.add(&small_stats);
         cl.error = cl.stats.error();
-        cl.members.extend(moved);
         self.plane_count -= 1;
         self.steps += 1;
     }
 
-    /// The post-processing rounds of [`PpeParams::refine_rounds`].
-    fn polish(&mut self) {
-        for _ in 0..self.params.refine_rounds {
-            let moved = self.refine_boundary();
-            let mut merged = self.merge_adjacent();
-            merged += self.merge_occluded();
-            if moved == 0 && merged == 0 {
-                break;
-            }
+    /// The member rays of `plane` in list order.
+    fn members(&self, plane: u32) -> impl Iterator<Item = usize> + '_ {
+        let cl = &self.clusters[plane as usize];
+        let mut m = cl.head;
+        (0..cl.len).map(move |_| {
+            let k = m as usize;
+            m = self.next[k];
+            k
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scramble_is_a_bijection_of_31_bit_ids() {
+        let ids = (0..1u32 << 31)
+            .step_by(99_991)
+            .chain([1, 2, 499, 500, ID_MASK as u32]);
+        for x in ids {
+            assert!(u64::from(scramble(x)) <= ID_MASK);
+            assert_eq!(unscramble(scramble(x)), x, "{x}");
         }
     }
 
-    /// Absolute radial residual of ray `k` on plane `w` (`∞` when the ray misses it).
-    fn residual(&self, w: &Vector3<f64>, k: usize) -> f64 {
-        let p = &self.points[k];
-        let r = p.norm();
-        let d = w.dot(p) / r;
-        if d > 0.0 {
-            (r - 1.0 / d).abs()
-        } else {
-            f64::INFINITY
-        }
-    }
-
-    /// One sweep of boundary refinement; returns the number of rays moved.
-    fn refine_boundary(&mut self) -> usize {
-        let min_points = self.params.min_points.max(4);
-        let big: Vec<Option<Vector3<f64>>> = self
-            .clusters
-            .iter()
-            .enumerate()
-            .map(|(id, cl)| {
-                (cl.parent as usize == id && cl.members.len() >= min_points)
-                    .then(|| cl.stats.solve().map(|(w, _)| w))
-                    .flatten()
-            })
-            .collect();
-        let plane_of = |l: u32| big.get(l as usize).copied().flatten();
-        let limit = self.params.max_increment_m2.sqrt();
-        let neighbours = [(-1i8, 0i8), (1, 0), (0, -1), (0, 1)];
-        let mut moves = Vec::new();
-        for k in 0..self.points.len() {
-            let own = self.label[k];
-            if own == NONE {
-                continue;
-            }
-            let mut best: Option<(f64, u32)> = plane_of(own).map(|w| (self.residual(&w, k), own));
-            let own_big = best.is_some();
-            let mut boundary = false;
-            for d in neighbours {
-                let Some(o) = self.cell(k, d) else { continue };
-                let lo = self.label[o];
-                if lo == NONE || lo == own || !self.edge(k, o) {
-                    continue;
-                }
-                boundary = true;
-                if let Some(w) = plane_of(lo) {
-                    let e = self.residual(&w, k);
-                    if best.is_none_or(|(b, _)| e < b) {
-                        best = Some((e, lo));
-                    }
-                }
-            }
-            if !boundary {
-                continue;
-            }
-            if let Some((e, to)) = best
-                && to != own
-                && (own_big || e <= limit)
-            {
-                moves.push((k, to));
-            }
-        }
-        for &(k, to) in &moves {
-            let from = self.label[k];
-            let ps = self.point_stats[k];
-            self.clusters[from as usize].stats.remove(&ps);
-            self.clusters[to as usize].stats.add(&ps);
-            self.label[k] = to;
-        }
-        if !moves.is_empty() {
-            for cl in &mut self.clusters {
-                cl.members.clear();
-            }
-            for (k, &l) in self.label.iter().enumerate() {
-                if l != NONE {
-                    self.clusters[l as usize].members.push(k as u32);
-                }
-            }
-            for cl in &mut self.clusters {
-                cl.error = if cl.members.len() >= 4 {
-                    cl.stats.error()
-                } else {
-                    0.0
-                };
-            }
-        }
-        moves.len()
-    }
-
-    /// Merges 4-adjacent planes, least increment first, while the increment is at most
-    /// `e`; returns the number of merges.
-    fn merge_adjacent(&mut self) -> usize {
-        let mut pairs = Vec::new();
-        for k in 0..self.points.len() {
-            let a = self.label[k];
-            if a == NONE {
-                continue;
-            }
-            for o in [k + 1, k + self.width] {
-                if o < self.points.len() && self.edge(k, o) {
-                    let b = self.label[o];
-                    if b != NONE && b != a {
-                        pairs.push((a.min(b), a.max(b)));
-                    }
-                }
-            }
-        }
-        pairs.sort_unstable();
-        pairs.dedup();
-        pairs.retain(|&(a, b)| {
-            self.clusters[a as usize].members.len() >= 4
-                && self.clusters[b as usize].members.len() >= 4
-        });
-        self.merge_pairs(pairs)
-    }
-
-    /// Merges planes that are pieces of one surface seen on both sides of an occluder:
-    /// along a row or column, plane `a` ends, only rays **in front of** the joint plane of
-    /// `a` and `b` follow (by more than three RMS residuals of the joint fit), then plane `b`
-    /// begins; the merge is executed when its increment is at most `e`. Returns the number
-    /// of merges.
-    fn merge_occluded(&mut self) -> usize {
-        let min_points = self.params.min_points.max(4);
-        let is_big = |s: &Self, l: u32| {
-            l != NONE
-                && s.clusters
-                    .get(l as usize)
-                    .is_some_and(|c| c.members.len() >= min_points)
-        };
-        // Candidate gaps: (a, b, first gap ray, last gap ray, stride).
-        let mut gaps: Vec<(u32, u32, usize, usize, usize)> = Vec::new();
-        let lines = (0..self.height)
-            .map(|row| (row * self.width, 1, self.width))
-            .chain((0..self.width).map(|col| (col, self.width, self.height)));
-        for (start, stride, len) in lines {
-            // The last ray of the most recent distinct planes along the line.
-            let mut recent: [(u32, usize); 4] = [(NONE, 0); 4];
-            for i in 0..len {
-                let k = start + i * stride;
-                let l = self.label[k];
-                if !is_big(self, l) {
-                    continue;
-                }
-                if recent[0].0 != l {
-                    for &(a, ka) in &recent {
-                        if a != NONE && a != l && k - ka > stride {
-                            gaps.push((a.min(l), a.max(l), ka + stride, k - stride, stride));
-                        }
-                    }
-                    if let Some(pos) = recent.iter().position(|r| r.0 == l) {
-                        recent[..=pos].rotate_right(1);
-                    } else {
-                        recent.rotate_right(1);
-                    }
-                }
-                recent[0] = (l, k);
-            }
-        }
-        // Joint plane and occlusion margin of each pair.
-        type Joint = Option<(Vector3<f64>, f64)>;
-        let mut cache: std::collections::HashMap<(u32, u32), Joint> =
-            std::collections::HashMap::new();
-        let mut pairs = Vec::new();
-        for (a, b, first, last, stride) in gaps {
-            let joint = *cache.entry((a, b)).or_insert_with(|| {
-                let st = self.clusters[a as usize]
-                    .stats
-                    .union(&self.clusters[b as usize].stats);
-                st.solve()
-                    .map(|(w, sse)| (w, 3.0 * (sse / st.n.max(1) as f64).sqrt()))
-            });
-            let Some((w, margin)) = joint else { continue };
-            let occluded = (first..=last).step_by(stride).all(|k| {
-                let p = &self.points[k];
-                if !self.valid[k] {
-                    return false;
-                }
-                let r = p.norm();
-                let d = w.dot(p) / r;
-                d > 0.0 && r < 1.0 / d - margin
-            });
-            if occluded {
-                pairs.push((a, b));
-            }
-        }
-        pairs.sort_unstable();
-        pairs.dedup();
-        self.merge_pairs(pairs)
-    }
-
-    /// Merges the given plane pairs (and what they become), least increment first, while the
-    /// increment stays at most `e`; a pair whose increment grew since it was queued goes back
-    /// into the queue. Returns the number of merges.
-    fn merge_pairs(&mut self, pairs: Vec<(u32, u32)>) -> usize {
-        let e_max = self.params.max_increment_m2;
-        let mut heap: BinaryHeap<Entry> = pairs
-            .into_iter()
-            .map(|(a, b)| Entry {
-                key: self.mrg_increment(a, b),
-                action: Action::Merge { a, b },
-            })
-            .filter(|e| e.key <= e_max)
-            .collect();
-        let mut merged = 0;
-        while let Some(entry) = heap.pop() {
-            let Action::Merge { a, b } = entry.action else {
-                continue;
-            };
-            let (ra, rb) = (self.root(a), self.root(b));
-            if ra == rb {
-                continue;
-            }
-            let key = self.mrg_increment(ra, rb);
-            if key > e_max {
-                continue;
-            }
-            if key > entry.key && heap.peek().is_some_and(|n| key > n.key) {
-                heap.push(Entry {
-                    key,
-                    action: Action::Merge { a: ra, b: rb },
-                });
-                continue;
-            }
-            self.merge(ra, rb);
-            merged += 1;
-        }
-        merged
-    }
-
-    fn finish(self) -> Segmentation {
-        let min_points = self.params.min_points.max(4);
-        let alive: Vec<&Cluster> = self
-            .clusters
-            .iter()
-            .enumerate()
-            .filter(|(id, cl)| cl.parent as usize == *id && cl.members.len() >= min_points)
-            .map(|(_, cl)| cl)
-            .collect();
-        let points = self.points;
-        let mut planes: Vec<Plane> = alive
-            .into_par_iter()
-            .filter_map(|cl| {
-                let (w0, _) = cl.stats.solve()?;
-                let buf: Vec<Vector3<f64>> =
-                    cl.members.iter().map(|&m| points[m as usize]).collect();
-                let fit = refine(w0, &buf, 1e-6, 20)?;
-                let mut index: Vec<usize> = cl.members.iter().map(|&m| m as usize).collect();
-                index.sort_unstable();
-                Some(Plane { index, fit })
-            })
-            .collect();
-        planes.sort_by(|a, b| {
-            b.index
-                .len()
-                .cmp(&a.index.len())
-                .then(a.index.cmp(&b.index))
-        });
-        let mut labels = vec![None; self.points.len()];
-        for (id, p) in planes.iter().enumerate() {
-            for &i in &p.index {
-                labels[i] = Some(id as u32);
-            }
-        }
-        Segmentation {
-            width: self.width,
-            height: self.height,
-            labels,
-            planes,
-            steps: self.steps,
+    #[test]
+    fn actions_survive_packing() {
+        let big = ID_MASK as u32;
+        for action in [
+            Action::Create {
+                point: big,
+                mask: 16,
+            },
+            Action::Extend {
+                plane: 7,
+                point: big,
+            },
+            Action::Merge { a: big, b: 0 },
+        ] {
+            assert_eq!(
+                format!("{:?}", Action::unpack(action.pack())),
+                format!("{action:?}")
+            );
         }
     }
 }

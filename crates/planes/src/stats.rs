@@ -79,46 +79,137 @@ impl PlaneStats {
     /// `None` when the points do not determine a plane (fewer than three points, collinear
     /// points, or points on a plane through the sensor).
     pub fn solve(&self) -> Option<(Vector3<f64>, f64)> {
-        if self.n < 3 {
-            return None;
-        }
-        // Symmetric 3 × 3 solve by cofactors (A is positive semi-definite).
         let a = &self.a;
-        let (a00, a01, a02, a11, a12, a22) = (
+        let upper = [
             a[(0, 0)],
             a[(0, 1)],
             a[(0, 2)],
             a[(1, 1)],
             a[(1, 2)],
             a[(2, 2)],
-        );
-        let c00 = a11 * a22 - a12 * a12;
-        let c01 = a02 * a12 - a01 * a22;
-        let c02 = a01 * a12 - a02 * a11;
-        let c11 = a00 * a22 - a02 * a02;
-        let c12 = a01 * a02 - a00 * a12;
-        let c22 = a00 * a11 - a01 * a01;
-        let det = a00 * c00 + a01 * c01 + a02 * c02;
-        // Reject numerically singular systems (collinear points, planes through the sensor).
-        let scale = a00.max(a11).max(a22);
-        if det.is_nan() || det <= scale * scale * scale * 1e-15 {
-            return None;
-        }
-        let b = &self.b;
-        let w = Vector3::new(
-            c00 * b.x + c01 * b.y + c02 * b.z,
-            c01 * b.x + c11 * b.y + c12 * b.z,
-            c02 * b.x + c12 * b.y + c22 * b.z,
-        ) / det;
-        let sse = (self.c - b.dot(&w)).max(0.0);
-        if !w.iter().all(|x| x.is_finite()) || !sse.is_finite() {
-            return None;
-        }
-        Some((w, sse))
+        ];
+        solve_upper(&upper, &self.b, self.c, self.n)
     }
 
     /// The error of the set in m² (`∞` when no plane is determined, `0` for fewer than
     /// four points in general position, which any plane explains).
+    pub fn error(&self) -> f64 {
+        self.solve().map_or(f64::INFINITY, |(_, e)| e)
+    }
+}
+
+/// The minimizing plane of the statistics with `A` given by its upper triangle
+/// (`a00 a01 a02 a11 a12 a22`); see [`PlaneStats::solve`].
+#[inline]
+fn solve_upper(u: &[f64; 6], b: &Vector3<f64>, c: f64, n: usize) -> Option<(Vector3<f64>, f64)> {
+    if n < 3 {
+        return None;
+    }
+    // Symmetric 3 × 3 solve by cofactors (A is positive semi-definite).
+    let [a00, a01, a02, a11, a12, a22] = *u;
+    let c00 = a11 * a22 - a12 * a12;
+    let c01 = a02 * a12 - a01 * a22;
+    let c02 = a01 * a12 - a02 * a11;
+    let c11 = a00 * a22 - a02 * a02;
+    let c12 = a01 * a02 - a00 * a12;
+    let c22 = a00 * a11 - a01 * a01;
+    let det = a00 * c00 + a01 * c01 + a02 * c02;
+    // Reject numerically singular systems (collinear points, planes through the sensor).
+    let scale = a00.max(a11).max(a22);
+    if det.is_nan() || det <= scale * scale * scale * 1e-15 {
+        return None;
+    }
+    let w = Vector3::new(
+        c00 * b.x + c01 * b.y + c02 * b.z,
+        c01 * b.x + c11 * b.y + c12 * b.z,
+        c02 * b.x + c12 * b.y + c22 * b.z,
+    ) / det;
+    let sse = (c - b.dot(&w)).max(0.0);
+    if !w.iter().all(|x| x.is_finite()) || !sse.is_finite() {
+        return None;
+    }
+    Some((w, sse))
+}
+
+/// [`PlaneStats`] in 88 bytes for the clustering of [`crate::extract`], which keeps one per
+/// ray and one per plane: the upper triangle of `A` (`A` is symmetric), `b`, `c` and `n`
+/// in one array. Its sums and solves are those of [`PlaneStats`], bit for bit.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct Moments {
+    /// `a00 a01 a02 a11 a12 a22 b0 b1 b2 c`.
+    m: [f64; 10],
+    /// Number of endpoints.
+    pub n: usize,
+}
+
+impl From<&PlaneStats> for Moments {
+    fn from(s: &PlaneStats) -> Self {
+        let a = &s.a;
+        Self {
+            m: [
+                a[(0, 0)],
+                a[(0, 1)],
+                a[(0, 2)],
+                a[(1, 1)],
+                a[(1, 2)],
+                a[(2, 2)],
+                s.b.x,
+                s.b.y,
+                s.b.z,
+                s.c,
+            ],
+            n: s.n,
+        }
+    }
+}
+
+impl Moments {
+    /// Statistics of one endpoint (as [`PlaneStats::of_point`]).
+    #[inline]
+    pub fn of_point(p: &Vector3<f64>) -> Self {
+        Self::from(&PlaneStats::of_point(p))
+    }
+
+    /// Adds another set.
+    #[inline]
+    pub fn add(&mut self, other: &Self) {
+        for (x, y) in self.m.iter_mut().zip(&other.m) {
+            *x += y;
+        }
+        self.n += other.n;
+    }
+
+    /// Removes a subset previously added.
+    #[inline]
+    pub fn remove(&mut self, other: &Self) {
+        for (x, y) in self.m.iter_mut().zip(&other.m) {
+            *x -= y;
+        }
+        self.n = self.n.saturating_sub(other.n);
+    }
+
+    /// The union of two sets.
+    #[inline]
+    pub fn union(&self, other: &Self) -> Self {
+        let mut s = *self;
+        s.add(other);
+        s
+    }
+
+    /// As [`PlaneStats::solve`].
+    #[inline]
+    pub fn solve(&self) -> Option<(Vector3<f64>, f64)> {
+        let [a00, a01, a02, a11, a12, a22, b0, b1, b2, c] = self.m;
+        solve_upper(
+            &[a00, a01, a02, a11, a12, a22],
+            &Vector3::new(b0, b1, b2),
+            c,
+            self.n,
+        )
+    }
+
+    /// As [`PlaneStats::error`].
+    #[inline]
     pub fn error(&self) -> f64 {
         self.solve().map_or(f64::INFINITY, |(_, e)| e)
     }
