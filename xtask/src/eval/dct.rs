@@ -14,7 +14,7 @@
 //! 9.4's t_GPOM and t_HM). As a control, the DCT map is also scored through that raster.
 //! The headline (real logs) goes to the README's crate map.
 //!
-//! In stages: one unit per log ([`measure`]), the page ([`report`]) from their results.
+//! In stages: one unit per log ([`measure`]), the page ([`report()`]) from their results.
 
 use std::path::PathBuf;
 
