@@ -1,8 +1,33 @@
-//! Times the phases of scan insertion on a `.graph` file (development aid).
+//! Times scan insertion on a `.graph` file and prints the map's sizes and a digest of its
+//! leaves (development aid).
 #![allow(missing_docs, clippy::unwrap_used)]
 use std::time::Instant;
 
 use raypath_rtree_grid::{FusionRule, GridConfig, RtreeGrid, Selection, SensorModel};
+
+/// An order-independent digest of the leaf set (boxes and probabilities): equal digests
+/// mean equal maps.
+fn leaf_digest(grid: &RtreeGrid) -> u64 {
+    let mut leaves: Vec<([u16; 6], u64)> = grid
+        .cuboids()
+        .iter()
+        .map(|c| {
+            let (lo, hi) = (c.keys.lo, c.keys.hi);
+            (
+                [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]],
+                c.probability.to_bits(),
+            )
+        })
+        .collect();
+    leaves.sort_unstable();
+    leaves.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, (k, p)| {
+        let mut h = h;
+        for v in k.iter().map(|&v| u64::from(v)).chain([*p]) {
+            h = (h ^ v).wrapping_mul(0x0100_0000_01b3);
+        }
+        h
+    })
+}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -90,11 +115,17 @@ fn main() {
         }
         grid.fuse_pending();
         let secs = t.elapsed().as_secs_f64();
+        let working_bytes = grid.memory_bytes();
         grid.shrink_to_fit();
         let s = grid.stats();
         println!(
-            "{label}: {secs:.3} s, {keys} key updates, {} leaves, {} fused, {splits} splits, {} bytes",
-            s.leaves, s.fused_leaves, s.bytes
+            "{label}: {secs:.3} s, {keys} key updates, {} leaves, {} fused, {splits} splits, {} nodes, {} bytes ({working_bytes} before shrink_to_fit), {} base cubes, leaf digest {:016x}",
+            s.leaves,
+            s.fused_leaves,
+            s.nodes,
+            s.bytes,
+            s.base_cubes,
+            leaf_digest(&grid)
         );
     }
 }

@@ -1,147 +1,102 @@
-//! The lattice index: base-cube key → cell id, an open-addressing hash table.
+//! The lattice index: unfused base-cube key → cell id.
 //!
-//! Unfused base cubes are found in O(1) instead of an R-tree descent. The table stores only
-//! the 4-byte cell id per slot; the key is read back from the cell, so an entry costs
-//! 4 bytes / load factor (≤ ¾) — 5.3 to 10.7 bytes per indexed cell. Linear probing with
-//! backward-shift deletion (no tombstones).
+//! Unfused base cubes are found in `O(1)` instead of an R-tree descent (Khan 2017, §2.4).
+//! A [`RobinTable`] under the key's hash with 4 tag bits of the hash; the key itself is not
+//! stored but read back from the cell (`key_of(id)`, its box's lower corner) for the entries
+//! whose tag matches — 6 bytes per slot.
 
 use crate::key::{Key, pack};
+use crate::robin::RobinTable;
 
-const EMPTY: u32 = u32::MAX;
+/// Tag bits per slot (the other 12 hold the displacement).
+const TAG_BITS: u32 = 4;
 
 /// Key → cell-id table; keys are looked up through a caller-supplied `key_of(id)`.
 #[derive(Clone, Debug, Default)]
-#[allow(dead_code)]
-pub struct LatticeIndex {
-    slots: Vec<u32>,
-    len: usize,
+pub(crate) struct LatticeIndex {
+    table: RobinTable<TAG_BITS>,
 }
 
+/// The home slot of `key` in `table` and its tag. Keys of one 2³ block get consecutive
+/// homes (the block's hash, plus the key's place in the block), so the look-ups of a scan
+/// and of a fusion, which walk neighbouring cubes, touch few cache lines; the tag is a byte
+/// of the block's hash.
 #[inline]
-fn hash(key: Key) -> u64 {
-    let mut h = pack(key).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+fn home_and_tag(table: &RobinTable<TAG_BITS>, key: Key) -> (usize, u16) {
+    let block = pack(key.map(|k| k >> 1));
+    let mut h = block.wrapping_mul(0x9E37_79B9_7F4A_7C15);
     h ^= h >> 29;
-    h.wrapping_mul(0xBF58_476D_1CE4_E5B9)
+    h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    let local = usize::from((key[0] & 1) | ((key[1] & 1) << 1) | ((key[2] & 1) << 2));
+    let n = table.slots();
+    let mut home = table.home(h) + local;
+    if home >= n {
+        home -= n;
+    }
+    (home, (h >> 8) as u16 & ((1 << TAG_BITS) - 1))
 }
 
-#[allow(dead_code)]
 impl LatticeIndex {
-    /// An empty table with room for `n` entries before it grows.
-    pub fn with_capacity(n: usize) -> Self {
-        let slots = ((n * 4).div_ceil(3) + 1).next_power_of_two().max(64);
+    /// An empty table for `n` entries (at rest: growing starts at the next insertion).
+    pub(crate) fn with_capacity(n: usize) -> Self {
         Self {
-            slots: vec![EMPTY; slots],
-            len: 0,
+            table: RobinTable::for_entries(n),
         }
     }
 
     /// Number of indexed cells.
-    pub fn len(&self) -> usize {
-        self.len
+    #[cfg(test)]
+    fn len(&self) -> usize {
+        self.table.len()
     }
 
-    /// Whether no cell is indexed.
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-
-    /// Bytes of the slot array.
-    pub fn memory_bytes(&self) -> usize {
-        self.slots.capacity() * 4
-    }
-
-    #[inline]
-    fn mask(&self) -> usize {
-        self.slots.len() - 1
+    /// Bytes of the slot arrays.
+    pub(crate) fn memory_bytes(&self) -> usize {
+        self.table.memory_bytes()
     }
 
     /// The id stored for `key`.
     #[inline]
-    pub fn get(&self, key: Key, key_of: impl Fn(u32) -> Key) -> Option<u32> {
-        if self.slots.is_empty() {
-            return None;
-        }
-        let mask = self.mask();
-        let mut i = hash(key) as usize & mask;
-        loop {
-            let id = self.slots[i];
-            if id == EMPTY {
-                return None;
-            }
-            if key_of(id) == key {
-                return Some(id);
-            }
-            i = (i + 1) & mask;
-        }
+    pub(crate) fn get(&self, key: Key, key_of: impl Fn(u32) -> Key) -> Option<u32> {
+        let (home, tag) = home_and_tag(&self.table, key);
+        self.table.find(home, |id, t| t == tag && key_of(id) == key)
     }
 
-    /// Stores `id` for `key` (the key must not be present).
-    pub fn insert(&mut self, key: Key, id: u32, key_of: impl Fn(u32) -> Key) {
-        if (self.len + 1) * 4 > self.slots.len() * 3 {
+    /// Stores `id` for `key` (the key must not be present); `key_of` gives the keys of the
+    /// stored ids when the table grows.
+    pub(crate) fn insert(&mut self, key: Key, id: u32, key_of: impl Fn(u32) -> Key) {
+        if !self.table.has_room(1) {
             self.grow(&key_of);
         }
-        let mask = self.mask();
-        let mut i = hash(key) as usize & mask;
-        while self.slots[i] != EMPTY {
-            i = (i + 1) & mask;
+        self.place(key, id, key_of);
+    }
+
+    /// Stores `id` for `key` without the load check (growing only when it does not fit).
+    pub(crate) fn place(&mut self, key: Key, id: u32, key_of: impl Fn(u32) -> Key) {
+        loop {
+            let (home, tag) = home_and_tag(&self.table, key);
+            if self.table.insert(home, id, tag) {
+                return;
+            }
+            self.grow(&key_of);
         }
-        self.slots[i] = id;
-        self.len += 1;
     }
 
     fn grow(&mut self, key_of: &impl Fn(u32) -> Key) {
-        let new_len = (self.slots.len() * 2).max(64);
-        debug_assert!(new_len.is_power_of_two());
-        let old = std::mem::replace(&mut self.slots, vec![EMPTY; new_len]);
-        let mask = self.mask();
-        for id in old.into_iter().filter(|&id| id != EMPTY) {
-            let mut i = hash(key_of(id)) as usize & mask;
-            while self.slots[i] != EMPTY {
-                i = (i + 1) & mask;
-            }
-            self.slots[i] = id;
+        let ids = self.table.drain_ids();
+        self.table = self.table.doubled();
+        for id in ids {
+            let (home, tag) = home_and_tag(&self.table, key_of(id));
+            let placed = self.table.insert(home, id, tag);
+            debug_assert!(placed);
         }
     }
 
-    /// Removes `key`; returns its id.
-    pub fn remove(&mut self, key: Key, key_of: impl Fn(u32) -> Key) -> Option<u32> {
-        if self.slots.is_empty() {
-            return None;
-        }
-        let mask = self.mask();
-        let mut i = hash(key) as usize & mask;
-        loop {
-            let id = self.slots[i];
-            if id == EMPTY {
-                return None;
-            }
-            if key_of(id) == key {
-                break;
-            }
-            i = (i + 1) & mask;
-        }
-        let removed = self.slots[i];
-        // Backward-shift deletion.
-        let mut hole = i;
-        let mut j = (i + 1) & mask;
-        loop {
-            let id = self.slots[j];
-            if id == EMPTY {
-                break;
-            }
-            let home = hash(key_of(id)) as usize & mask;
-            // Move `id` into the hole when its home is not cyclically in (hole, j].
-            let dist_home = j.wrapping_sub(home) & mask;
-            let dist_hole = j.wrapping_sub(hole) & mask;
-            if dist_home >= dist_hole {
-                self.slots[hole] = id;
-                hole = j;
-            }
-            j = (j + 1) & mask;
-        }
-        self.slots[hole] = EMPTY;
-        self.len -= 1;
-        Some(removed)
+    /// Removes `key`; returns whether it was present.
+    pub(crate) fn remove(&mut self, key: Key, key_of: impl Fn(u32) -> Key) -> bool {
+        let (home, tag) = home_and_tag(&self.table, key);
+        self.table
+            .remove(home, |id, t| t == tag && key_of(id) == key)
     }
 }
 
@@ -168,7 +123,7 @@ mod tests {
                         index.insert(key, u32::from(k), key_of);
                     }
                 } else {
-                    let expected = model.remove(&k).map(|_| u32::from(k));
+                    let expected = model.remove(&k).is_some();
                     prop_assert_eq!(index.remove(key, key_of), expected);
                 }
                 prop_assert_eq!(index.len(), model.len());

@@ -50,6 +50,21 @@ pub fn unpack(packed: u64) -> Key {
     ]
 }
 
+/// The Morton (Z-order) code of a key: its bits interleaved, x lowest.
+#[inline]
+pub fn morton(key: Key) -> u64 {
+    /// Spreads the 16 bits of `v` to every third bit.
+    fn spread(v: u16) -> u64 {
+        let mut x = u64::from(v);
+        x = (x | (x << 32)) & 0x001F_0000_0000_FFFF;
+        x = (x | (x << 16)) & 0x001F_0000_FF00_00FF;
+        x = (x | (x << 8)) & 0x100F_00F0_0F00_F00F;
+        x = (x | (x << 4)) & 0x10C3_0C30_C30C_30C3;
+        (x | (x << 2)) & 0x1249_2492_4924_9249
+    }
+    spread(key[0]) | (spread(key[1]) << 1) | (spread(key[2]) << 2)
+}
+
 /// An axis-aligned box of base cubes: keys `lo[a] ..= hi[a]` on each axis `a`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct KeyBox {
@@ -155,5 +170,24 @@ mod tests {
         assert_eq!(b.volume(), 2);
         assert_eq!(b.min_m(0.5), [0.0; 3]);
         assert_eq!(b.max_m(0.5), [1.0, 0.5, 0.5]);
+    }
+
+    #[test]
+    fn morton_interleaves_the_bits() {
+        for key in [
+            [0, 0, 0],
+            [1, 0, 0],
+            [0, 1, 0],
+            [0, 0, 1],
+            [65535, 1234, 40000],
+        ] {
+            let mut naive = 0u64;
+            for bit in 0..16 {
+                for (axis, k) in key.iter().enumerate() {
+                    naive |= u64::from((k >> bit) & 1) << (3 * bit + axis);
+                }
+            }
+            assert_eq!(morton(key), naive, "{key:?}");
+        }
     }
 }

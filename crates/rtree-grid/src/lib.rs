@@ -16,42 +16,54 @@
 //!   Guttman's condense/re-insert of fused cells, and in-place updates of leaf payloads;
 //!   `rstar` implements the R*-tree (different split and forced re-insertion), has no
 //!   payload update by id and stores generic `f64` envelopes. [`RTree`] is an arena: flat
-//!   vectors with `M + 1` child slots per node, a box block per inner node, item boxes stored
+//!   vectors with `M` child slots per node (the `M + 1`-th entry of an overflowing node
+//!   waits beside the arena for its split), a box block per inner node, item records stored
 //!   once by item id — no per-node heap allocation; boxes are 16-bit lattice keys
 //!   ([`KeyBox`], 12 bytes).
-//! * **Payload outside the tree.** A cell is its box (in the tree) and a 4-byte log-odds
-//!   (in the grid); updating occupancy never touches the tree.
-//! * **O(1) updates of unfused cells.** A lattice index (open addressing, 4 bytes per slot,
-//!   load ≤ ¾) maps a base-cube key to its cell, so a scan update is a hash probe, not an
-//!   R-tree descent. Keys missing from it search the tree only in the 16³ blocks a fused
-//!   cell touches (a count per block), so new cells elsewhere cost one tree insertion.
+//! * **A cell is one 16-byte record.** Its box and its 4-byte log-odds (the item's value)
+//!   sit together in the tree's item table, so a look-up reads both in one memory access;
+//!   updating occupancy never touches the hierarchy.
+//! * **Look-ups without the tree.** A lattice index maps an unfused base cube to its cell,
+//!   a fused-cell index (each fused cell under the 4³ blocks it touches, tagged with the
+//!   2³ octants it covers there) finds the fused cell holding a cube: a scan update or a
+//!   fusion slab check is one or two hash probes, never an R-tree descent (both are
+//!   Robin Hood tables of 6-byte slots; the keys of a 2³ block have neighbouring slots).
+//! * **One tree update per scan.** Between public calls the tree holds exactly the leaves;
+//!   during a scan cells are created and deleted in the indexes only, and the net change is
+//!   applied once at the end — Guttman's Delete for the dead cells (as one batch: entries
+//!   leave their nodes, then one bottom-up CondenseTree pass), then Insert for the new ones
+//!   in lattice order. Cells created and fused away within a scan (fusion chains, split
+//!   pieces) never enter the tree.
 //! * **Batched scans.** A scan is traversed once (exact voxel traversal on the lattice) into a
 //!   vector of packed keys — a small direct-mapped cache drops the repeats of neighbouring beams —
 //!   then sorted and de-duplicated (occupied wins over free, OctoMap's `insertPointCloud` rule; the
 //!   thesis does not say) and applied; fused cells get one update per scan.
 //! * **Fusion only from selected cells** (§2.5.2, Fig. 2.6): end-point cells plus traversed cells
-//!   drawn at random ([`Selection`]); only clamped candidates are kept.
-//! * **Fused-cell look-ups without the tree.** Per 16³ block, a 64-bit mask of the 4³
-//!   sub-blocks fused cells touch; a direct-mapped cache (2¹⁶ slots) of the fused cell last
-//!   found per 4³ block; slabs of ≤ 64 base cubes checked cube by cube and larger ones
-//!   probed at up to 4³ spread points before the slab query; an item → leaf map (4 B per
-//!   cell, dropped by [`RtreeGrid::shrink_to_fit`]) so removals skip Guttman's FindLeaf.
+//!   drawn at random ([`Selection`]); only clamped candidates are kept. Slabs are checked cube
+//!   by cube along their rows, jumping over each cell found (corners first for slabs of more
+//!   than 64 cubes).
 //! * **Fusion interval** ([`GridConfig::fusion_interval_scans`], default 1 = the thesis):
 //!   fusing every k scans (seeds accumulate; [`RtreeGrid::fuse_pending`] runs them) saves
 //!   the split / re-fuse churn of the equal-value rule on a moving sensor.
 //! * **Compaction.** Fusion frees cell ids and nodes; once half the ids are dead, an `O(n)`
-//!   pass renumbers cells in tree order and rebuilds the arenas ([`RtreeGrid::compact`]).
+//!   pass renumbers cells in tree order and rebuilds the arenas and indexes
+//!   ([`RtreeGrid::compact`]); [`RtreeGrid::shrink_to_fit`] also sizes the indexes tight.
 //!
 //! Per scan with `n` beams crossing `c` distinct cubes: traversal `O(Σ beam cells)`, sorting
-//! `O(c log c)`, updates `O(c)` hash probes plus `O(M log_d N)` per new cell, and fusion
-//! `O(|T| · (log N + k))` for `|T|` selected cells and `k` leaves per slab query.
+//! `O(c log c)`, updates `O(c)` hash probes, fusion `O(|T| + Σ V)` probes for `|T|` selected
+//! cells and `V` cubes per checked slab, and `O(M log_d N)` per cell the scan adds to or
+//! removes from the tree (plus splits and re-insertions).
 //!
 //! # Errata and decisions
 //!
 //! * A slab fuses only if it is **exactly tiled** by leaves lying completely inside it, all
 //!   clamped with the polarity of `g_i` — coverage and non-overlap checks the thesis omits.
 //! * The fused probability is the equal-weight mean over the cells (g_i included).
-//! * Cells removed earlier in the same pass are skipped; + before − per axis.
+//! * Search directions try + before − per axis.
+//! * Selected cells start fusions in Morton order of their lower corners (the thesis gives
+//!   no order); a selected cell fused into a larger one or split since it was selected starts
+//!   from the cell now holding its lower corner. The leaves depend on the scans only, not on
+//!   M, cell ids or the tree's shape.
 //! * Beam samples: each de-duplicated traversed cell is a candidate with probability
 //!   `1 / spacing` (the thesis samples cells at random along each beam by its length but gives
 //!   no number; `⌈len / (s·r)⌉` random positions per beam give the same expected number, and
@@ -98,11 +110,12 @@
 //! ```
 
 pub mod config;
-mod coverage;
 mod export;
+mod fused_index;
 mod grid;
 mod index;
 pub mod key;
+mod robin;
 pub mod rtree;
 
 pub use config::{FusionRule, GridConfig, Selection, SensorModel};

@@ -55,50 +55,49 @@ impl RtreeGrid {
     /// call); returns the number of fusion steps.
     pub(super) fn fuse(&mut self, mut id: u32) -> usize {
         let mut steps = 0;
-        let mut members: Vec<u32> = Vec::new();
-        loop {
-            let cell = self.cell(id);
-            if cell.log_odds.is_nan() {
-                return steps; // removed earlier in this pass
-            }
-            if !self.may_fuse(cell.log_odds) {
-                return steps;
-            }
-            if self.config.model == SensorModel::BeamEndPoint && cell.log_odds <= self.l_threshold {
-                return steps; // §2.5.2, beam-end-point model: only occupied fusion
-            }
-            let mut fused = None;
-            for direction in search_order(cell.bx.widths()) {
-                let Some(slab) = slab(&cell.bx, direction) else {
-                    continue;
-                };
-                if self.slab_fuses(&slab, cell.log_odds, &mut members) {
-                    fused = Some(slab);
-                    break;
-                }
-            }
-            let Some(slab) = fused else {
-                return steps;
-            };
-            // The fused cell's probability is the mean of its cells' (equal weight per
-            // cell, g_i included); all are clamped to the same bound. Under the equal-value
-            // rule all are bit-equal and the value is kept as it is.
-            let value = match self.config.fusion_rule {
-                FusionRule::EqualValue => cell.log_odds,
-                FusionRule::Clamped => {
-                    let mut sum = f64::from(cell.log_odds);
-                    for &m in &members {
-                        sum += f64::from(self.log_odds[m as usize]);
-                    }
-                    (sum / (members.len() + 1) as f64) as f32
-                }
-            };
-            self.delete_cell(id);
-            for &m in &members {
-                self.delete_cell(m);
-            }
-            id = self.create_cell(cell.bx.union(&slab), value);
+        let mut members = std::mem::take(&mut self.members);
+        while let Some(next) = self.fuse_step(id, &mut members) {
+            id = next;
             steps += 1;
+        }
+        self.members = members;
+        steps
+    }
+
+    /// One step of `Fuse(g_i)` on cell `id`: merges it with the slab of the first search
+    /// direction that fuses (`members` is scratch); returns the fused cell.
+    fn fuse_step(&mut self, id: u32, members: &mut Vec<u32>) -> Option<u32> {
+        let cell = self.cell(id);
+        if cell.log_odds.is_nan() || !self.may_fuse(cell.log_odds) {
+            return None; // removed earlier in this pass, or cannot fuse
+        }
+        if self.config.model == SensorModel::BeamEndPoint && cell.log_odds <= self.l_threshold {
+            return None; // §2.5.2, beam-end-point model: only occupied fusion
+        }
+        let slab = search_order(cell.bx.widths())
+            .into_iter()
+            .filter_map(|direction| slab(&cell.bx, direction))
+            .find(|slab| self.slab_fuses(slab, cell.log_odds, members))?;
+        let value = self.fused_value(cell.log_odds, members);
+        self.delete_cell(id);
+        for &m in members.iter() {
+            self.delete_cell(m);
+        }
+        Some(self.create_cell(cell.bx.union(&slab), value))
+    }
+
+    /// The log-odds of a fused cell from the seed's and its `members'`: the mean (equal
+    /// weight per cell, g_i included; all are clamped to the same bound), or under the
+    /// equal-value rule the common value as it is.
+    fn fused_value(&self, seed: f32, members: &[u32]) -> f32 {
+        match self.config.fusion_rule {
+            FusionRule::EqualValue => seed,
+            FusionRule::Clamped => {
+                let sum = members
+                    .iter()
+                    .fold(f64::from(seed), |sum, &m| sum + f64::from(self.lo(m)));
+                (sum / (members.len() + 1) as f64) as f32
+            }
         }
     }
 
@@ -117,33 +116,56 @@ impl RtreeGrid {
 
     /// Whether the slab is exactly tiled by leaves lying completely inside it, all fusing
     /// with the seed's log-odds `seed` (Eqs. 2.9–2.11 plus the coverage and containment
-    /// checks); fills `members` with them.
+    /// checks); fills `members` with them in lattice order (z, y, x of their lower corners).
+    ///
+    /// Each row of the slab is walked with point look-ups (lattice index, fused-cell index),
+    /// jumping over the cell found; the first cube in unknown space, in a cell reaching out
+    /// of the slab or of another value ends the walk. Large slabs first test their corners.
     fn slab_fuses(&self, slab: &KeyBox, seed: f32, members: &mut Vec<u32>) -> bool {
         members.clear();
-        let mut volume = 0u64;
-        let target = slab.volume();
-        if target == 1 {
-            // A single base cube: one index look-up.
-            return match self.index.get(slab.lo, Self::key_of_cell(&self.tree)) {
-                Some(id) if self.fuses_with(seed, self.log_odds[id as usize]) => {
+        let volume = slab.volume();
+        if volume == 1 {
+            // Only an unfused cube fits: one lattice-index probe.
+            let id = self.index.get(slab.lo, Self::key_of_cell(&self.tree));
+            return match id {
+                Some(id) if self.fuses_with(seed, self.lo(id)) => {
                     members.push(id);
                     true
                 }
                 _ => false,
             };
         }
-        if target <= SMALL_SLAB {
-            match self.small_slab_fuses(slab, seed, members) {
-                Some(answer) => return answer,
-                None => members.clear(),
+        if volume > CORNER_CHECK && !self.corners_join(slab, seed) {
+            return false;
+        }
+        for z in slab.lo[2]..=slab.hi[2] {
+            for y in slab.lo[1]..=slab.hi[1] {
+                let mut x = u32::from(slab.lo[0]);
+                while x <= u32::from(slab.hi[0]) {
+                    let key = [x as u16, y, z];
+                    let Some((id, bx)) = self.joining_cell(key, slab, seed) else {
+                        return false;
+                    };
+                    if bx.lo == key {
+                        members.push(id); // counted at its first cube
+                    }
+                    x = u32::from(bx.hi[0]) + 1;
+                }
             }
         }
-        // Necessary conditions on the slab's 8 corner cubes, checked with cheap look-ups
-        // (hash probe; near fused cells the last-found cell and the block cache) before the
-        // slab query: each must lie in a known cell of a fusing value inside the slab.
-        // Corners the caches cannot place are left to the slab query (a negative R-tree
-        // point query costs as much as the slab query).
-        for corner in 0..8u8 {
+        true
+    }
+
+    /// The cell holding base cube `key` if it lies inside `slab` and fuses with `seed`.
+    #[inline]
+    fn joining_cell(&self, key: Key, slab: &KeyBox, seed: f32) -> Option<(u32, KeyBox)> {
+        let (id, bx) = self.lookup(key)?;
+        (slab.contains_box(&bx) && self.fuses_with(seed, self.lo(id))).then_some((id, bx))
+    }
+
+    /// Whether the cells at the slab's 8 corner cubes may join (a necessary condition).
+    fn corners_join(&self, slab: &KeyBox, seed: f32) -> bool {
+        (0..8u8).all(|corner| {
             let key = [0, 1, 2].map(|a| {
                 if corner & (1 << a) != 0 {
                     slab.hi[a]
@@ -151,112 +173,13 @@ impl RtreeGrid {
                     slab.lo[a]
                 }
             });
-            if !self.probe_passes(key, slab, seed) {
-                return false;
-            }
-        }
-        // Larger slabs: up to 4 × 4 × 4 more probes spread over the slab catch unknown gaps
-        // and other values before the tree query.
-        if !self.probes_pass(slab, seed) {
-            return false;
-        }
-        let ok = self.tree.for_each_intersecting_while(slab, &mut |id, bx| {
-            if !slab.contains_box(bx) || !self.fuses_with(seed, self.log_odds[id as usize]) {
-                return false;
-            }
-            volume += bx.volume();
-            members.push(id);
-            true
-        });
-        ok && volume == target
+            self.joining_cell(key, slab, seed).is_some()
+        })
     }
 }
 
-impl RtreeGrid {
-    /// [`Self::slab_fuses`] for a small slab by looking up each of its base cubes (hash
-    /// probes; fused cells through the caches), stopping at the first cube that fails;
-    /// `None` when a cube needs a tree search.
-    fn small_slab_fuses(&self, slab: &KeyBox, seed: f32, members: &mut Vec<u32>) -> Option<bool> {
-        for z in slab.lo[2]..=slab.hi[2] {
-            for y in slab.lo[1]..=slab.hi[1] {
-                for x in slab.lo[0]..=slab.hi[0] {
-                    let key = [x, y, z];
-                    let id = match self.index.get(key, Self::key_of_cell(&self.tree)) {
-                        Some(id) => id,
-                        None if !self.coverage.may_contain(key) => return Some(false),
-                        None => {
-                            let id = self.fused_hint(key)?;
-                            let Some(bx) = self.tree.item_box(id) else {
-                                return Some(false);
-                            };
-                            if !slab.contains_box(&bx) {
-                                return Some(false);
-                            }
-                            if bx.lo != key {
-                                continue; // counted at its first cube (z, y, x order)
-                            }
-                            id
-                        }
-                    };
-                    if !self.fuses_with(seed, self.log_odds[id as usize]) {
-                        return Some(false);
-                    }
-                    members.push(id);
-                }
-            }
-        }
-        Some(true)
-    }
-}
-
-impl RtreeGrid {
-    /// One necessary condition of a slab fusion, checked with cheap look-ups (hash probe;
-    /// near fused cells the last-found cell and the block cache): the base cube `key` lies
-    /// in a known cell of a fusing value inside `slab`. `false` in unknown space or in a
-    /// cell that cannot join; a key the caches cannot place passes (the slab query decides).
-    fn probe_passes(&self, key: Key, slab: &KeyBox, seed: f32) -> bool {
-        let id = match self.index.get(key, Self::key_of_cell(&self.tree)) {
-            Some(id) => id,
-            None if !self.coverage.may_contain(key) => return false, // unknown space
-            None => match self.fused_hint(key) {
-                Some(id) => id,
-                None => return true,
-            },
-        };
-        self.fuses_with(seed, self.log_odds[id as usize])
-            && self
-                .tree
-                .item_box(id)
-                .is_some_and(|b| slab.contains_box(&b))
-    }
-
-    /// Probes a lattice of up to 4 per axis spread over `slab`: `false` when a probe lies
-    /// in unknown space or in a cell that cannot join the fusion (probes the caches cannot
-    /// place pass).
-    fn probes_pass(&self, slab: &KeyBox, seed: f32) -> bool {
-        let steps = slab.widths().map(|w| (w / 4).max(1));
-        let w = slab.widths();
-        for iz in 0..w[2].min(4) {
-            for iy in 0..w[1].min(4) {
-                for ix in 0..w[0].min(4) {
-                    let off = [ix, iy, iz];
-                    let key: [u16; 3] = [0, 1, 2].map(|a| {
-                        let k = u32::from(slab.lo[a]) + off[a] * steps[a] + steps[a] / 2;
-                        k.min(u32::from(slab.hi[a])) as u16
-                    });
-                    if !self.probe_passes(key, slab, seed) {
-                        return false;
-                    }
-                }
-            }
-        }
-        true
-    }
-}
-
-/// Slabs of at most this many base cubes are checked cube by cube instead of by a tree
-/// query.
-const SMALL_SLAB: u64 = 64;
+/// Slabs of more than this many base cubes test their corners before the row walk.
+const CORNER_CHECK: u64 = 64;
 
 #[cfg(test)]
 mod tests {

@@ -1,6 +1,6 @@
 //! The Rtree variable-resolution occupancy grid (Khan 2017, §2.5).
 
-mod cache;
+mod cells;
 mod fuse;
 mod query;
 mod ray;
@@ -12,15 +12,15 @@ use nalgebra::Point3;
 use raypath_geometry::{PointCloud, Pose3};
 
 use crate::config::{FusionRule, GridConfig, Selection, SensorModel, logit};
-use crate::coverage::FusedCoverage;
+use crate::fused_index::FusedIndex;
 use crate::index::LatticeIndex;
-use crate::key::{Key, KeyBox, key_of, pack, unpack};
+use crate::key::{Key, KeyBox, morton, pack, unpack};
 use crate::rtree::{OrderError, RTree};
 
 pub use query::{Cuboid, Occupancy};
 
-/// A leaf cell: its box of base cubes (stored once, in the tree) and its log-odds
-/// (4 bytes, in `log_odds`).
+/// A leaf cell: its box of base cubes and its log-odds (stored together, once, in the
+/// tree's item table).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Cell {
     bx: KeyBox,
@@ -74,7 +74,7 @@ pub struct GridStats {
     pub height: usize,
     /// Base cubes covered by leaves (the volume in units of r³).
     pub base_cubes: u64,
-    /// Bytes allocated by the map (tree arena, cells, lattice index).
+    /// Bytes allocated by the map (tree arena with the cells, look-up indexes).
     pub bytes: usize,
 }
 
@@ -83,13 +83,13 @@ pub struct GridStats {
 #[derive(Clone, Debug)]
 pub struct RtreeGrid {
     config: GridConfig,
+    /// The leaf cells: boxes and log-odds (as the items' values) by cell id.
     tree: RTree,
-    log_odds: Vec<f32>,
     free_cells: Vec<u32>,
     index: LatticeIndex,
+    fused: FusedIndex,
     fused_cells: usize,
-    coverage: FusedCoverage,
-    last_fused: Option<(u32, KeyBox)>,
+    pending: cells::Pending,
     l_hit: f32,
     l_miss: f32,
     l_min: f32,
@@ -100,10 +100,16 @@ pub struct RtreeGrid {
     occupied_keys: Vec<u64>,
     touched_fused: Vec<(u32, bool)>,
     touched_exact: Vec<(u32, u64, bool)>,
-    selected: Vec<u32>,
+    /// Fusion seeds: boxes of the cells selected since the last fusion pass.
+    selected: Vec<KeyBox>,
+    /// Fusion scratch: the seeds with their Morton codes, and a slab's member cells.
+    seed_order: Vec<(u64, u64, KeyBox)>,
+    members: Vec<u32>,
     recent: ray::RecentKeys,
-    fused_cache: cache::FusedCache,
 }
+
+/// Keys looked up ahead of their updates in a scan.
+const LOOKAHEAD: usize = 16;
 
 /// Slack when comparing a log-odds with a clamping bound.
 const CLAMP_EPS: f32 = 1e-4;
@@ -148,12 +154,11 @@ impl RtreeGrid {
         Ok(Self {
             config,
             tree,
-            log_odds: Vec::new(),
             free_cells: Vec::new(),
             index: LatticeIndex::default(),
+            fused: FusedIndex::default(),
             fused_cells: 0,
-            coverage: FusedCoverage::default(),
-            last_fused: None,
+            pending: cells::Pending::default(),
             l_hit: logit(config.prob_hit) as f32,
             l_miss: logit(config.prob_miss) as f32,
             l_min: logit(config.clamp_min) as f32,
@@ -166,7 +171,8 @@ impl RtreeGrid {
             touched_exact: Vec::new(),
             selected: Vec::new(),
             recent: ray::RecentKeys::new(),
-            fused_cache: cache::FusedCache::new(),
+            seed_order: Vec::new(),
+            members: Vec::new(),
         })
     }
 
@@ -190,18 +196,32 @@ impl RtreeGrid {
         self.tree.len()
     }
 
-    #[inline]
-    fn key_of_cell(tree: &RTree) -> impl Fn(u32) -> Key + '_ {
-        move |id| tree.item_box(id).map_or([0; 3], |b| b.lo)
-    }
-
-    /// The cell `id` (box from the tree, log-odds; NaN log-odds for a dead id).
+    /// The cell `id` (box and log-odds from the tree's item table; NaN log-odds for a dead
+    /// id).
     #[inline]
     fn cell(&self, id: u32) -> Cell {
-        Cell {
-            bx: self.tree.item_box(id).unwrap_or(KeyBox::cube([0; 3])),
-            log_odds: self.log_odds[id as usize],
+        match self.tree.item(id) {
+            Some((bx, bits)) => Cell {
+                bx,
+                log_odds: f32::from_bits(bits),
+            },
+            None => Cell {
+                bx: KeyBox::cube([0; 3]),
+                log_odds: f32::NAN,
+            },
         }
+    }
+
+    /// The log-odds of cell `id` (NaN for a dead id).
+    #[inline]
+    fn lo(&self, id: u32) -> f32 {
+        self.tree.item_value(id).map_or(f32::NAN, f32::from_bits)
+    }
+
+    /// Sets the log-odds of cell `id`.
+    #[inline]
+    fn set_lo(&mut self, id: u32, log_odds: f32) {
+        self.tree.set_item_value(id, log_odds.to_bits());
     }
 
     /// Inserts one scan of a sensor at `world_from_sensor` with points in the sensor frame;
@@ -219,98 +239,30 @@ impl RtreeGrid {
     /// Updates every touched cell once (occupied wins over free), then fuses (§2.5.3).
     pub fn insert_scan(&mut self, origin_m: &Point3<f64>, points_m: &[Point3<f64>]) -> ScanUpdate {
         let mut update = ScanUpdate::default();
-        let r = self.config.resolution_m;
-        let origin = [origin_m.x, origin_m.y, origin_m.z];
-        let beam = self.config.model == SensorModel::BeamBased;
-        // §2.5.2, Fig. 2.6: end-point cells always start fusions; each cell a beam traversed does
-        // so with probability 1 / spacing (the thesis samples random cells along each beam by its
-        // length, with no number; ⌈len / (s·r)⌉ per beam gives the same expected number, drawn
-        // here from the de-duplicated traversed cells).
-        let sample_probability = match self.config.selection {
-            _ if !beam || !self.config.fusion => 0.0,
-            Selection::BeamSamples { spacing_cells } => 1.0 / spacing_cells,
-            Selection::UpdatedCells => 1.0,
-        };
         let mut free_keys = std::mem::take(&mut self.free_keys);
         let mut occupied_keys = std::mem::take(&mut self.occupied_keys);
-        free_keys.clear();
-        occupied_keys.clear();
-        let mut recent = std::mem::replace(&mut self.recent, ray::RecentKeys { slots: Vec::new() });
-        recent.clear();
-        let mut rng = ray::SplitMix(self.config.seed ^ self.scans.wrapping_mul(0x9E37_79B9));
-        for p in points_m {
-            let mut end = [p.x, p.y, p.z];
-            if !end.iter().all(|v| v.is_finite()) {
-                continue;
-            }
-            let d = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
-            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            let mut hit = true;
-            if let Some(max) = self.config.max_range_m {
-                if len > max {
-                    let s = max / len;
-                    end = [
-                        origin[0] + d[0] * s,
-                        origin[1] + d[1] * s,
-                        origin[2] + d[2] * s,
-                    ];
-                    hit = false;
-                }
-            }
-            update.beams += 1;
-            match key_of(end, r) {
-                Some(k) if hit => occupied_keys.push(pack(k)),
-                Some(_) => {}
-                None => update.off_lattice += 1,
-            }
-            if beam {
-                ray::ray_keys_with(origin, end, r, |k| {
-                    if recent.insert(k) {
-                        free_keys.push(k);
-                    }
-                });
-            }
-        }
-        self.recent = recent;
-        occupied_keys.sort_unstable();
-        occupied_keys.dedup();
-        free_keys.sort_unstable();
-        free_keys.dedup();
-        // Occupied wins: drop free keys that are also hit (both lists are sorted).
-        {
-            let mut j = 0;
-            free_keys.retain(|k| {
-                while j < occupied_keys.len() && occupied_keys[j] < *k {
-                    j += 1;
-                }
-                !(j < occupied_keys.len() && occupied_keys[j] == *k)
-            });
-        }
+        self.gather_keys(
+            origin_m,
+            points_m,
+            &mut free_keys,
+            &mut occupied_keys,
+            &mut update,
+        );
         update.free_keys = free_keys.len();
         update.occupied_keys = occupied_keys.len();
         // Cells selected by earlier scans of this fusion interval stay selected.
         let mut selected = std::mem::take(&mut self.selected);
-        let fusion = self.config.fusion;
-        for (keys, hit) in [(&free_keys, false), (&occupied_keys, true)] {
-            for &packed in keys.iter() {
-                let id = self.update_key(unpack(packed), hit, &mut update);
-                let Some(id) = id else { continue };
-                let chosen = fusion
-                    && (hit || sample_probability >= 1.0 || rng.next_f64() < sample_probability);
-                // Only cells that may fuse start fusions (checked again when fusing).
-                if chosen && self.may_fuse(self.log_odds[id as usize]) {
-                    selected.push(id);
-                }
-            }
-        }
+        self.update_keys(&free_keys, &occupied_keys, &mut selected, &mut update);
         self.apply_fused_updates();
         self.apply_exact_updates(&mut selected, &mut update);
         self.scans += 1;
         self.selected = selected;
-        if fusion && self.scans % u64::from(self.config.fusion_interval_scans) == 0 {
-            update.fusions += self.fuse_pending();
+        let interval = u64::from(self.config.fusion_interval_scans);
+        if self.config.fusion && self.scans % interval == 0 {
+            update.fusions += self.fuse_seeds();
         }
-        if self.free_cells.len() > 4096 && self.free_cells.len() * 2 > self.log_odds.len() {
+        self.commit();
+        if self.free_cells.len() > 4096 && self.free_cells.len() * 2 > self.tree.item_slots() {
             self.compact();
         }
         self.free_keys = free_keys;
@@ -318,60 +270,89 @@ impl RtreeGrid {
         update
     }
 
+    /// Applies a scan's de-duplicated keys (free, then occupied) and selects fusion seeds.
+    fn update_keys(
+        &mut self,
+        free_keys: &[u64],
+        occupied_keys: &[u64],
+        selected: &mut Vec<KeyBox>,
+        update: &mut ScanUpdate,
+    ) {
+        // §2.5.2, Fig. 2.6: end-point cells always start fusions; each cell a beam traversed does
+        // so with probability 1 / spacing (the thesis samples random cells along each beam by its
+        // length, with no number; ⌈len / (s·r)⌉ per beam gives the same expected number, drawn
+        // here from the de-duplicated traversed cells).
+        let beam = self.config.model == SensorModel::BeamBased;
+        let sample_probability = match self.config.selection {
+            _ if !beam || !self.config.fusion => 0.0,
+            Selection::BeamSamples { spacing_cells } => 1.0 / spacing_cells,
+            Selection::UpdatedCells => 1.0,
+        };
+        let mut rng = ray::SplitMix(self.config.seed ^ self.scans.wrapping_mul(0x9E37_79B9));
+        let fusion = self.config.fusion;
+        // Look-ups run a chunk of keys ahead of the updates (independent memory accesses
+        // overlap): they stay valid, as fused cells do not change during this loop (their
+        // updates are queued) and the cube a key creates is no other key's. Sorted keys run
+        // along x, so the fused cell of the last key often holds the next one.
+        let mut last_fused: Option<(u32, KeyBox)> = None;
+        let mut found = [None; LOOKAHEAD];
+        for (keys, hit) in [(free_keys, false), (occupied_keys, true)] {
+            for chunk in keys.chunks(LOOKAHEAD) {
+                for (slot, &packed) in found.iter_mut().zip(chunk) {
+                    let key = unpack(packed);
+                    *slot = match last_fused.filter(|(_, bx)| bx.contains_key(key)) {
+                        Some(cell) => Some(cell),
+                        None => self.lookup(key),
+                    };
+                    if let Some(cell) = slot.filter(|(_, bx)| bx.volume() > 1) {
+                        last_fused = Some(cell);
+                    }
+                }
+                for (&cell, &packed) in found.iter().zip(chunk) {
+                    let (id, bx) = self.update_key(unpack(packed), cell, hit, update);
+                    let chosen = fusion
+                        && (hit
+                            || sample_probability >= 1.0
+                            || rng.next_f64() < sample_probability);
+                    // Only cells that may fuse start fusions (checked again when fusing).
+                    if chosen && self.may_fuse(self.lo(id)) {
+                        selected.push(bx);
+                    }
+                }
+            }
+        }
+    }
+
     /// Runs the fusions of the cells selected since the last fusion pass (those of the
     /// scans inside a [`GridConfig::fusion_interval_scans`]); returns the fusion steps.
     pub fn fuse_pending(&mut self) -> usize {
-        let mut selected = std::mem::take(&mut self.selected);
-        selected.sort_unstable();
-        selected.dedup();
-        let mut steps = 0;
-        for &id in &selected {
-            steps += self.fuse(id);
-        }
-        selected.clear();
-        self.selected = selected;
+        let steps = self.fuse_seeds();
+        self.commit();
         steps
     }
 
-    /// The id of the cell containing base cube `key`.
-    fn cell_id_of_key(&self, key: Key) -> Option<u32> {
-        if let Some(id) = self.index.get(key, Self::key_of_cell(&self.tree)) {
-            return Some(id);
+    /// Fuses from the selected cells in Morton order of their lower corners (then of their
+    /// upper corners); a seed fused into a larger cell or split since it was selected starts
+    /// from the cell now holding its lower corner. The leaves depend on the scans only, not
+    /// on cell ids or the tree's shape.
+    fn fuse_seeds(&mut self) -> usize {
+        let mut order = std::mem::take(&mut self.seed_order);
+        order.clear();
+        order.extend(
+            self.selected
+                .drain(..)
+                .map(|b| (morton(b.lo), morton(b.hi), b)),
+        );
+        order.sort_unstable_by_key(|&(lo, hi, _)| (lo, hi));
+        order.dedup_by_key(|&mut (lo, hi, _)| (lo, hi));
+        let mut steps = 0;
+        for &(_, _, seed) in &order {
+            if let Some(id) = self.cell_id_of_key(seed.lo) {
+                steps += self.fuse(id);
+            }
         }
-        if !self.coverage.may_contain(key) {
-            return None;
-        }
-        self.tree.find_containing(key).map(|(id, _)| id)
-    }
-
-    /// The live fused cell containing `key` if the last-found cell or the block cache
-    /// knows it (no tree search).
-    #[inline]
-    fn fused_hint(&self, key: Key) -> Option<u32> {
-        if let Some((id, _)) = self.last_fused.filter(|&(_, bx)| bx.contains_key(key)) {
-            return Some(id);
-        }
-        let id = self.fused_cache.get(key)?;
-        let bx = self.tree.item_box(id)?;
-        let l = self.log_odds.get(id as usize)?;
-        (!l.is_nan() && bx.volume() > 1 && bx.contains_key(key)).then_some(id)
-    }
-
-    /// The fused cell containing `key` (not in the lattice index): the last one found, the
-    /// block cache, then an R-tree point query.
-    fn find_fused(&mut self, key: Key) -> Option<(u32, KeyBox)> {
-        if let Some(found) = self.last_fused.filter(|&(_, bx)| bx.contains_key(key)) {
-            return Some(found);
-        }
-        if let Some(id) = self.fused_hint(key) {
-            let found = (id, self.tree.item_box(id).unwrap_or(KeyBox::cube(key)));
-            self.last_fused = Some(found);
-            return Some(found);
-        }
-        let found = self.tree.find_containing(key)?;
-        self.fused_cache.put(key, found.0);
-        self.last_fused = Some(found);
-        Some(found)
+        self.seed_order = order;
+        steps
     }
 
     #[inline]
@@ -380,32 +361,33 @@ impl RtreeGrid {
         (log_odds + delta).clamp(self.l_min, self.l_max) // Eq. (2.7), clamped
     }
 
-    /// Applies one update to the cell holding `key` (creating it) and returns the cell id;
-    /// updates of fused cells are queued and applied once per scan.
-    fn update_key(&mut self, key: Key, hit: bool, update: &mut ScanUpdate) -> Option<u32> {
-        if let Some(id) = self.index.get(key, Self::key_of_cell(&self.tree)) {
-            let l = self.log_odds[id as usize];
-            self.log_odds[id as usize] = self.updated(l, hit);
-            return Some(id);
+    /// Applies one update to the cell holding `key` (`found`, looked up; created when
+    /// `None`) and returns the cell; updates of fused cells are queued and applied once per
+    /// scan.
+    fn update_key(
+        &mut self,
+        key: Key,
+        found: Option<(u32, KeyBox)>,
+        hit: bool,
+        update: &mut ScanUpdate,
+    ) -> (u32, KeyBox) {
+        let Some((id, bx)) = found else {
+            let l = self.updated(0.0, hit);
+            update.created += 1;
+            let bx = KeyBox::cube(key);
+            return (self.create_cell(bx, l), bx);
+        };
+        let l = self.lo(id);
+        if bx.volume() == 1 {
+            self.set_lo(id, self.updated(l, hit));
+            return (id, bx);
         }
-        if self.coverage.may_contain(key) {
-            // Sorted keys run along x: the previous fused cell often holds the next key too.
-            if let Some((id, _)) = self.find_fused(key) {
-                if self.exact_updates() {
-                    let l = self.log_odds[id as usize];
-                    if !self.keeps_value(l, self.updated(l, hit)) {
-                        self.touched_exact.push((id, pack(key), hit));
-                    }
-                    return Some(id);
-                }
-                self.touched_fused.push((id, hit));
-                return Some(id);
-            }
+        if !self.exact_updates() {
+            self.touched_fused.push((id, hit));
+        } else if !self.keeps_value(l, self.updated(l, hit)) {
+            self.touched_exact.push((id, pack(key), hit));
         }
-        let l = self.updated(0.0, hit);
-        let id = self.create_cell(KeyBox::cube(key), l);
-        update.created += 1;
-        Some(id)
+        (id, bx)
     }
 
     /// Updates every fused cell touched this scan once; occupied wins.
@@ -417,9 +399,9 @@ impl RtreeGrid {
             if touched.get(i + 1).is_some_and(|next| next.0 == id) {
                 continue;
             }
-            let l = self.log_odds[id as usize];
+            let l = self.lo(id);
             if !l.is_nan() {
-                self.log_odds[id as usize] = self.updated(l, hit);
+                self.set_lo(id, self.updated(l, hit));
             }
         }
         touched.clear();
@@ -465,39 +447,6 @@ impl RtreeGrid {
         }
     }
 
-    fn create_cell(&mut self, bx: KeyBox, log_odds: f32) -> u32 {
-        let id = if let Some(id) = self.free_cells.pop() {
-            self.log_odds[id as usize] = log_odds;
-            id
-        } else {
-            self.log_odds.push(log_odds);
-            (self.log_odds.len() - 1) as u32
-        };
-        self.tree.insert(id, bx);
-        if bx.volume() == 1 {
-            self.index.insert(bx.lo, id, Self::key_of_cell(&self.tree));
-        } else {
-            self.fused_cells += 1;
-            self.coverage.add(&bx);
-        }
-        id
-    }
-
-    fn delete_cell(&mut self, id: u32) -> Cell {
-        self.last_fused = None;
-        let cell = self.cell(id);
-        if cell.bx.volume() == 1 {
-            self.index.remove(cell.bx.lo, Self::key_of_cell(&self.tree));
-        } else {
-            self.fused_cells -= 1;
-            self.coverage.remove(&cell.bx);
-        }
-        self.tree.remove(id);
-        self.log_odds[id as usize] = f32::NAN;
-        self.free_cells.push(id);
-        cell
-    }
-
     /// Sizes of the map.
     pub fn stats(&self) -> GridStats {
         let mut stats = GridStats {
@@ -510,66 +459,53 @@ impl RtreeGrid {
         };
         self.tree.for_each_item(&mut |id, bx| {
             stats.base_cubes += bx.volume();
-            if self.log_odds[id as usize] > self.l_threshold {
+            if self.lo(id) > self.l_threshold {
                 stats.occupied_leaves += 1;
             }
         });
         stats
     }
 
-    /// Bytes allocated by the map: the tree arena (with the cell boxes), the log-odds (4 B per cell), the free
-    /// list and the lattice index (excluding per-scan scratch vectors).
+    /// Bytes allocated by the map: the tree arena (with the cells' boxes and log-odds), the
+    /// free list, the lattice and fused-cell indexes and the bit set of cells not yet in the
+    /// tree (excluding per-scan scratch vectors).
     pub fn memory_bytes(&self) -> usize {
         self.tree.memory_bytes()
-            + self.log_odds.capacity() * size_of::<f32>()
             + self.free_cells.capacity() * 4
             + self.index.memory_bytes()
-            + self.coverage.memory_bytes()
+            + self.fused.memory_bytes()
+            + self.pending.memory_bytes()
             + size_of::<Self>()
     }
 
     /// Renumbers the cells and rebuilds the arenas without the holes left by fusion
-    /// (`O(n)`; runs automatically after a scan once half the cell ids are dead).
+    /// (`O(n)`; runs automatically after a scan once half the cell ids are dead). The
+    /// look-up indexes are rebuilt with room to grow to twice their size.
     pub fn compact(&mut self) {
-        self.last_fused = None;
-        self.fused_cache.clear();
-        let map = self.tree.compact();
-        let mut log_odds = vec![0.0f32; self.tree.len()];
-        for (old, &new) in map.iter().enumerate() {
-            if let (Some(slot), Some(&l)) = (log_odds.get_mut(new as usize), self.log_odds.get(old))
-            {
-                *slot = l;
-            }
-        }
-        self.log_odds = log_odds;
-        self.free_cells = Vec::new();
-        // Pending fusion seeds follow the renumbering (dead ids are dropped).
-        self.selected = self
-            .selected
-            .iter()
-            .filter_map(|&old| map.get(old as usize).copied())
-            .filter(|&new| new != u32::MAX)
-            .collect();
-        let mut index = LatticeIndex::with_capacity(self.tree.len() - self.fused_cells);
-        let tree = &self.tree;
-        tree.for_each_item(&mut |id, bx| {
-            if bx.volume() == 1 {
-                index.insert(bx.lo, id, Self::key_of_cell(tree));
-            }
-        });
-        self.index = index;
+        self.compact_with(2);
     }
 
-    /// Compacts the map and releases spare capacity (per-scan scratch and vector slack).
+    /// [`Self::compact`] with index room for `room` times the current cells.
+    fn compact_with(&mut self, room: usize) {
+        self.commit();
+        self.tree.compact();
+        self.free_cells = Vec::new();
+        self.pending.shrink_to_fit();
+        self.rebuild_indexes(room);
+    }
+
+    /// Compacts the map and releases spare capacity (per-scan scratch, vector slack, index
+    /// room).
     pub fn shrink_to_fit(&mut self) {
-        self.compact();
+        self.compact_with(1);
         self.tree.shrink_to_fit();
-        self.log_odds.shrink_to_fit();
         self.free_cells.shrink_to_fit();
         self.free_keys = Vec::new();
         self.occupied_keys = Vec::new();
         self.selected.shrink_to_fit(); // pending fusion seeds are kept
         self.touched_fused = Vec::new();
         self.touched_exact = Vec::new();
+        self.seed_order = Vec::new();
+        self.members = Vec::new();
     }
 }

@@ -35,7 +35,7 @@ pub struct Cuboid {
 impl RtreeGrid {
     fn cuboid(&self, id: u32, bx: &KeyBox) -> Cuboid {
         let r = self.config.resolution_m;
-        let l = self.log_odds[id as usize];
+        let l = self.lo(id);
         Cuboid {
             min_m: bx.min_m(r),
             max_m: bx.max_m(r),
@@ -96,7 +96,7 @@ impl RtreeGrid {
             let Some(id) = self.cell_id_of_key(key) else {
                 continue;
             };
-            if self.log_odds[id as usize] > self.l_threshold {
+            if self.lo(id) > self.l_threshold {
                 let cube = KeyBox::cube(key);
                 let r = self.config.resolution_m;
                 let (lo, hi) = (cube.min_m(r), cube.max_m(r));
@@ -135,7 +135,7 @@ impl RtreeGrid {
         let mut n = 0;
         let threshold = self.l_threshold;
         self.tree.for_each_item(&mut |id, bx| {
-            if self.log_odds[id as usize] > threshold {
+            if self.lo(id) > threshold {
                 n += 1;
                 visit(bx);
             }

@@ -1,4 +1,4 @@
-//! Beam traversal of the global lattice and the beam sampler.
+//! Beam traversal of the global lattice (a scan's keys) and the beam sampler.
 //!
 //! [`ray_keys`] is the exact voxel traversal of Amanatides & Woo (1987) on the unbounded
 //! 16-bit lattice, with OctoMap's conventions (`computeRayKeys`): the keys of every base
@@ -7,7 +7,87 @@
 //! traversal works on bounded `Grid3`s; the grid here has no bounds, so the same stepping
 //! runs on integer keys.)
 
+use nalgebra::Point3;
+
+use super::{RtreeGrid, ScanUpdate, SensorModel};
 use crate::key::{KEY_OFFSET, key_of, pack};
+
+impl RtreeGrid {
+    /// Traverses a scan's beams into sorted, de-duplicated packed keys: `occupied` the end
+    /// cubes of beams within range, `free` the cubes the beams cross (beam-based model), minus
+    /// the occupied ones (occupied wins, OctoMap's `insertPointCloud` rule).
+    pub(super) fn gather_keys(
+        &mut self,
+        origin_m: &Point3<f64>,
+        points_m: &[Point3<f64>],
+        free: &mut Vec<u64>,
+        occupied: &mut Vec<u64>,
+        update: &mut ScanUpdate,
+    ) {
+        let r = self.config.resolution_m;
+        let origin = [origin_m.x, origin_m.y, origin_m.z];
+        let beam = self.config.model == SensorModel::BeamBased;
+        free.clear();
+        occupied.clear();
+        let recent = &mut self.recent;
+        recent.clear();
+        for p in points_m {
+            let Some((end, hit)) = beam_end(origin, [p.x, p.y, p.z], self.config.max_range_m)
+            else {
+                continue;
+            };
+            update.beams += 1;
+            match key_of(end, r) {
+                Some(k) if hit => occupied.push(pack(k)),
+                Some(_) => {}
+                None => update.off_lattice += 1,
+            }
+            if beam {
+                ray_keys_with(origin, end, r, |k| {
+                    if recent.insert(k) {
+                        free.push(k);
+                    }
+                });
+            }
+        }
+        occupied.sort_unstable();
+        occupied.dedup();
+        free.sort_unstable();
+        free.dedup();
+        // Occupied wins: drop free keys that are also hit (both lists are sorted).
+        let mut j = 0;
+        free.retain(|k| {
+            while j < occupied.len() && occupied[j] < *k {
+                j += 1;
+            }
+            !(j < occupied.len() && occupied[j] == *k)
+        });
+    }
+}
+
+/// The end of a beam and whether it is a hit: beams longer than `max_range` are cut there
+/// and free only (OctoMap's `maxrange`); `None` for a non-finite end point.
+fn beam_end(origin: [f64; 3], end: [f64; 3], max_range: Option<f64>) -> Option<([f64; 3], bool)> {
+    if !end.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let d = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
+    let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    match max_range {
+        Some(max) if len > max => {
+            let s = max / len;
+            Some((
+                [
+                    origin[0] + d[0] * s,
+                    origin[1] + d[1] * s,
+                    origin[2] + d[2] * s,
+                ],
+                false,
+            ))
+        }
+        _ => Some((end, true)),
+    }
+}
 
 /// Appends the packed keys of the cubes the segment `origin → end` crosses before the cube
 /// of `end`.

@@ -15,7 +15,11 @@ use crate::key::{Key, KeyBox, unpack};
 impl RtreeGrid {
     /// Applies the queued exact updates of fused cells, splitting them where needed; the
     /// changed base cubes join `selected` (fusion seeds) when fusion is on.
-    pub(super) fn apply_exact_updates(&mut self, selected: &mut Vec<u32>, update: &mut ScanUpdate) {
+    pub(super) fn apply_exact_updates(
+        &mut self,
+        selected: &mut Vec<KeyBox>,
+        update: &mut ScanUpdate,
+    ) {
         let mut touched = std::mem::take(&mut self.touched_exact);
         touched.sort_unstable_by_key(|&(id, key, _)| (id, key));
         let mut changed: Vec<(Key, f32)> = Vec::new();
@@ -41,7 +45,7 @@ impl RtreeGrid {
             if group.len() as u64 == cell.bx.volume()
                 && changed.iter().all(|c| c.1.to_bits() == first.to_bits())
             {
-                self.log_odds[id as usize] = first;
+                self.set_lo(id, first);
                 continue;
             }
             self.delete_cell(id);
@@ -59,16 +63,16 @@ impl RtreeGrid {
         bx: KeyBox,
         old: f32,
         changed: &mut [(Key, f32)],
-        selected: &mut Vec<u32>,
+        selected: &mut Vec<KeyBox>,
     ) {
         if changed.is_empty() {
             self.create_cell(bx, old);
             return;
         }
         if bx.volume() == 1 {
-            let id = self.create_cell(bx, changed[0].1);
+            self.create_cell(bx, changed[0].1);
             if self.config.fusion && self.may_fuse(changed[0].1) {
-                selected.push(id);
+                selected.push(bx);
             }
             return;
         }

@@ -78,7 +78,7 @@ proptest! {
         // was updated after fusing; so check the weaker, exact property on the fused leaves.
         let mut mixed = 0;
         grid.tree.for_each_item(&mut |id, bx| {
-            if bx.volume() > 1 && grid.is_clamped(grid.log_odds[id as usize]).is_none() {
+            if bx.volume() > 1 && grid.is_clamped(grid.lo(id)).is_none() {
                 mixed += 1;
             }
         });
@@ -112,7 +112,7 @@ fn fused_leaves_hold_one_polarity_of_the_plain_grid() {
                         .index
                         .get([x, y, z], RtreeGrid::key_of_cell(&reference.tree))
                         .unwrap();
-                    let l = reference.log_odds[id as usize];
+                    let l = reference.lo(id);
                     assert_eq!(l > reference.l_threshold, c.occupied);
                 }
             }
@@ -278,13 +278,13 @@ fn compaction_keeps_the_map_and_frees_memory() {
 fn assert_matches_plain(grid: &RtreeGrid, reference: &RtreeGrid, tolerance: f32) {
     assert_eq!(check(grid), reference.num_leaves() as u64);
     reference.tree.for_each_item(&mut |id, bx| {
-        let expected = reference.log_odds[id as usize];
+        let expected = reference.lo(id);
         let (got_id, got_box) = grid
             .cell_id_of_key(bx.lo)
             .and_then(|g| grid.tree.item_box(g).map(|b| (g, b)))
             .unwrap_or_else(|| panic!("cube {:?} missing", bx.lo));
         assert!(got_box.contains_key(bx.lo));
-        let got = grid.log_odds[got_id as usize];
+        let got = grid.lo(got_id);
         if tolerance == 0.0 {
             assert_eq!(got.to_bits(), expected.to_bits(), "cube {:?}", bx.lo);
         } else {
@@ -351,6 +351,51 @@ proptest! {
             prop_assert!(grid.stats().fused_leaves > 0);
             prop_assert!(grid.num_leaves() < reference.num_leaves());
         }
+    }
+}
+
+/// The leaves (boxes and log-odds bits) in a canonical order.
+fn leaf_set(grid: &RtreeGrid) -> Vec<(KeyBox, u32)> {
+    let mut leaves = Vec::new();
+    grid.tree
+        .for_each_item(&mut |id, bx| leaves.push((*bx, grid.lo(id).to_bits())));
+    leaves.sort_unstable_by_key(|(b, l)| (pack(b.lo), pack(b.hi), *l));
+    leaves
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(16))]
+
+    /// Fusion depends on the scans only: the same scans give the same leaves whatever the
+    /// R-tree's order (its shape, the cell ids and compaction differ).
+    #[test]
+    fn leaves_do_not_depend_on_the_tree(
+        seed in any::<u64>(),
+        equal in any::<bool>(),
+        updated in any::<bool>(),
+        scans in 1usize..6,
+    ) {
+        let data = moving_scans(seed, scans, 250);
+        let mut leaves = Vec::new();
+        for m in [4usize, 8, 16] {
+            let mut config = GridConfig::with(0.25, m, SensorModel::BeamBased);
+            if updated {
+                config.selection = Selection::UpdatedCells;
+            }
+            if equal {
+                config.fusion_rule = FusionRule::EqualValue;
+            }
+            let mut grid = RtreeGrid::new(config).unwrap();
+            for (origin, points) in &data {
+                grid.insert_scan(origin, points);
+            }
+            if m == 16 {
+                grid.shrink_to_fit();
+            }
+            leaves.push(leaf_set(&grid));
+        }
+        prop_assert_eq!(&leaves[0], &leaves[1]);
+        prop_assert_eq!(&leaves[1], &leaves[2]);
     }
 }
 

@@ -7,17 +7,20 @@
 //! quadratic split; deletion removes the entry, tightens the boxes on the path to the root and
 //! re-inserts the entries of nodes that fall below `d` at their own level (CondenseTree).
 //!
-//! Nodes live in one arena: node `n` owns the `M + 1` child-id slots `n·(M+1) ..` of the
-//! flat `ids` vector (one spare slot takes the overflowing entry before a split); inner nodes
-//! also own a block of `M + 1` boxes in `inner_boxes`. Item boxes are stored once, indexed by
-//! item id (`item_boxes`), so a leaf entry costs a 4-byte slot plus the item's 12-byte box, and
-//! no node is a separate heap allocation. Freed nodes and box blocks are recycled. Item ids
-//! are small `u32`s chosen by the caller (dense ids keep `item_boxes` compact).
+//! Nodes live in one arena: node `n` owns the `M` child-id slots `n·M ..` of the flat `ids`
+//! vector (the overflowing `M + 1`-th entry waits in `spill` for the split that follows at
+//! once); inner nodes also own a block of `M` boxes in `inner_boxes`. Item boxes are stored
+//! once, indexed by item id (`items`), each with a 4-byte value of the caller's beside it (one
+//! memory access reads both), so a leaf entry costs a 4-byte slot plus the item's 16-byte
+//! record, and no node is a separate heap allocation. Freed nodes and box blocks are
+//! recycled. Item ids are small `u32`s chosen by the caller (dense ids keep `items` compact).
+//! Items may be removed one by one or in a batch (one CondenseTree pass, `delete`).
 //!
 //! Complexity (n items, h = log_d n levels): insertion `O(h·M)` plus `O(M²)` per split;
 //! deletion a FindLeaf search (`O(h·M)` without overlaps) plus `O(h·M)` tightening; box and
 //! point queries visit only the subtrees whose boxes meet the query.
 
+mod delete;
 mod split;
 #[cfg(test)]
 mod tests;
@@ -44,13 +47,30 @@ pub enum OrderError {
     },
 }
 
+/// An item's box and the caller's 4-byte value (16 bytes: read together).
+#[derive(Clone, Copy, Debug)]
+struct Item {
+    bx: KeyBox,
+    value: u32,
+}
+
+impl Item {
+    const EMPTY: Self = Self {
+        bx: KeyBox {
+            lo: [0; 3],
+            hi: [0; 3],
+        },
+        value: 0,
+    };
+}
+
 /// An arena-allocated R-tree of order (d, M) whose leaf entries are `(KeyBox, item id)`.
 #[derive(Clone, Debug)]
 pub struct RTree {
     max_entries: usize,
     min_entries: usize,
     cap: usize,
-    item_boxes: Vec<KeyBox>,
+    items: Vec<Item>,
     item_leaf: Vec<u32>,
     inner_boxes: Vec<KeyBox>,
     box_block: Vec<u32>,
@@ -64,6 +84,12 @@ pub struct RTree {
     len: usize,
     scratch: Vec<(KeyBox, u32)>,
     orphans: Vec<(KeyBox, u32, u8)>,
+    /// The `M + 1`-th entry of the node about to be split.
+    spill: Option<(KeyBox, u32)>,
+    /// Split scratch: which entries have a group.
+    assigned: Vec<bool>,
+    /// Deletion scratch: nodes that lost entries.
+    touched: Vec<u32>,
 }
 
 impl RTree {
@@ -81,8 +107,8 @@ impl RTree {
         let mut tree = Self {
             max_entries,
             min_entries,
-            cap: max_entries + 1,
-            item_boxes: Vec::new(),
+            cap: max_entries,
+            items: Vec::new(),
             item_leaf: Vec::new(),
             inner_boxes: Vec::new(),
             box_block: Vec::new(),
@@ -96,6 +122,9 @@ impl RTree {
             len: 0,
             scratch: Vec::new(),
             orphans: Vec::new(),
+            spill: None,
+            assigned: Vec::new(),
+            touched: Vec::new(),
         };
         tree.root = tree.alloc_node(0);
         Ok(tree)
@@ -134,7 +163,8 @@ impl RTree {
     /// Bytes held by the arena (allocated capacity of every vector).
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of;
-        (self.item_boxes.capacity() + self.inner_boxes.capacity()) * size_of::<KeyBox>()
+        self.items.capacity() * size_of::<Item>()
+            + self.inner_boxes.capacity() * size_of::<KeyBox>()
             + self.item_leaf.capacity() * 4
             + (self.box_block.capacity() + self.free_blocks.capacity()) * 4
             + self.ids.capacity() * 4
@@ -144,13 +174,15 @@ impl RTree {
             + self.free_nodes.capacity() * 4
             + self.scratch.capacity() * size_of::<(KeyBox, u32)>()
             + self.orphans.capacity() * size_of::<(KeyBox, u32, u8)>()
+            + self.assigned.capacity()
+            + self.touched.capacity() * 4
             + size_of::<Self>()
     }
 
     /// Releases spare capacity of the arena and drops the item → leaf map that speeds up
     /// removals (4 bytes per item; refilled as items are inserted or move).
     pub fn shrink_to_fit(&mut self) {
-        self.item_boxes.shrink_to_fit();
+        self.items.shrink_to_fit();
         // The item → leaf map only speeds up removals; it is rebuilt as items move.
         self.item_leaf = Vec::new();
         self.inner_boxes.shrink_to_fit();
@@ -163,6 +195,8 @@ impl RTree {
         self.free_nodes.shrink_to_fit();
         self.scratch = Vec::new();
         self.orphans = Vec::new();
+        self.assigned = Vec::new();
+        self.touched = Vec::new();
     }
 
     #[inline]
@@ -220,7 +254,7 @@ impl RTree {
     fn entry_box(&self, node: u32, i: usize) -> KeyBox {
         let block = self.box_block[node as usize];
         if block == NONE {
-            self.item_boxes[self.ids[self.slot(node, i)] as usize]
+            self.items[self.ids[self.slot(node, i)] as usize].bx
         } else {
             self.inner_boxes[block as usize * self.cap + i]
         }
@@ -249,9 +283,48 @@ impl RTree {
         }
     }
 
-    /// The box stored for `item` (meaningful only while the item is in the tree).
+    /// The box stored for `item` (meaningful while the item is in the tree or after
+    /// [`store_item`](Self::store_item)).
+    #[inline]
     pub fn item_box(&self, item: u32) -> Option<KeyBox> {
-        self.item_boxes.get(item as usize).copied()
+        self.items.get(item as usize).map(|i| i.bx)
+    }
+
+    /// The box and the value stored for `item`.
+    #[inline]
+    pub fn item(&self, item: u32) -> Option<(KeyBox, u32)> {
+        self.items.get(item as usize).map(|i| (i.bx, i.value))
+    }
+
+    /// The caller's 4-byte value stored beside `item`'s box (0 until set).
+    #[inline]
+    pub fn item_value(&self, item: u32) -> Option<u32> {
+        self.items.get(item as usize).map(|i| i.value)
+    }
+
+    /// Sets the value of `item` (an item the table holds: in the tree or stored).
+    #[inline]
+    pub fn set_item_value(&mut self, item: u32, value: u32) {
+        if let Some(i) = self.items.get_mut(item as usize) {
+            i.value = value;
+        }
+    }
+
+    /// Number of item ids the table has room for (one past the largest stored id).
+    pub fn item_slots(&self) -> usize {
+        self.items.len()
+    }
+
+    /// Stores the box and value of an item that is not in the tree (yet):
+    /// [`item_box`](Self::item_box) returns the box, queries do not see it until
+    /// [`insert`](Self::insert). The item must not be in the tree (its entries would read
+    /// the new box).
+    pub fn store_item(&mut self, item: u32, bx: KeyBox, value: u32) {
+        let id = item as usize;
+        if id >= self.items.len() {
+            self.items.resize(id + 1, Item::EMPTY);
+        }
+        self.items[id] = Item { bx, value };
     }
 
     #[inline]
@@ -277,22 +350,31 @@ impl RTree {
         Some(acc)
     }
 
+    /// Appends an entry; into a full node it goes to `spill`, and the caller splits the
+    /// node before anything else reads it.
     fn push_entry(&mut self, node: u32, bx: KeyBox, id: u32) {
         let i = self.len_of(node);
-        let s = self.slot(node, i);
-        self.ids[s] = id;
         self.count[node as usize] += 1;
+        if i == self.cap {
+            debug_assert!(self.spill.is_none());
+            self.spill = Some((bx, id));
+        } else {
+            let s = self.slot(node, i);
+            self.ids[s] = id;
+            if self.level[node as usize] > 0 {
+                self.set_entry_box(node, i, bx);
+            }
+        }
         if self.level[node as usize] > 0 {
-            self.set_entry_box(node, i, bx);
             self.parent[id as usize] = node;
         } else {
             let id = id as usize;
-            if id >= self.item_boxes.len() {
-                self.item_boxes.resize(id + 1, KeyBox::cube([0; 3]));
+            if id >= self.items.len() {
+                self.items.resize(id + 1, Item::EMPTY);
             }
-            self.item_boxes[id] = bx;
+            self.items[id].bx = bx;
             if id >= self.item_leaf.len() {
-                self.item_leaf.resize(self.item_boxes.len(), NONE);
+                self.item_leaf.resize(self.items.len(), NONE);
             }
             self.item_leaf[id] = node;
         }
@@ -327,22 +409,7 @@ impl RTree {
         let mut node = self.root;
         while self.level[node as usize] > level {
             // ChooseSubtree: least enlargement, ties to the smaller volume.
-            let start = self.box_block[node as usize] as usize * self.cap;
-            let boxes = &self.inner_boxes[start..start + self.len_of(node)];
-            let mut best = 0;
-            let mut best_key = (u64::MAX, u64::MAX);
-            for (i, b) in boxes.iter().enumerate() {
-                let volume = b.volume();
-                let enlargement = if b.contains_box(&bx) {
-                    0
-                } else {
-                    b.union(&bx).volume() - volume
-                };
-                if (enlargement, volume) < best_key {
-                    best_key = (enlargement, volume);
-                    best = i;
-                }
-            }
+            let best = choose_subtree(self.inner_entry_boxes(node), &bx);
             node = self.id_at(node, best);
         }
         self.push_entry(node, bx, id);
@@ -392,110 +459,6 @@ impl RTree {
         }
     }
 
-    /// Removes `item`; returns its box, `None` when it is not in the tree (Guttman Delete:
-    /// FindLeaf, remove, CondenseTree, shorten the tree).
-    pub fn remove(&mut self, item: u32) -> Option<KeyBox> {
-        let bx = self.item_box(item)?;
-        // The leaf node last holding the item (kept by push_entry), else a search.
-        let remembered = self.item_leaf.get(item as usize).and_then(|&leaf| {
-            (leaf != NONE && (leaf as usize) < self.count.len() && self.level[leaf as usize] == 0)
-                .then(|| (0..self.len_of(leaf)).find(|&i| self.id_at(leaf, i) == item))
-                .flatten()
-                .map(|i| (leaf, i))
-        });
-        let (leaf, i) = match remembered {
-            Some(found) => found,
-            None => self.find_leaf(self.root, item, &bx)?,
-        };
-        self.remove_slot(leaf, i);
-        self.len -= 1;
-        self.condense(leaf);
-        Some(bx)
-    }
-
-    fn find_leaf(&self, node: u32, item: u32, bx: &KeyBox) -> Option<(u32, usize)> {
-        let n = self.len_of(node);
-        if self.level[node as usize] == 0 {
-            return (0..n)
-                .find(|&i| self.id_at(node, i) == item)
-                .map(|i| (node, i));
-        }
-        for i in 0..n {
-            if self.entry_box(node, i).contains_box(bx) {
-                if let Some(found) = self.find_leaf(self.id_at(node, i), item, bx) {
-                    return Some(found);
-                }
-            }
-        }
-        None
-    }
-
-    fn condense(&mut self, leaf: u32) {
-        let mut orphans = std::mem::take(&mut self.orphans);
-        orphans.clear();
-        let mut node = leaf;
-        while node != self.root {
-            let parent = self.parent[node as usize];
-            let i = self.index_of_child(parent, node);
-            if self.len_of(node) < self.min_entries {
-                self.remove_slot(parent, i);
-                let level = self.level[node as usize];
-                for e in 0..self.len_of(node) {
-                    orphans.push((self.entry_box(node, e), self.id_at(node, e), level));
-                }
-                self.free_node(node);
-            } else if let Some(b) = self.node_box(node) {
-                self.set_entry_box(parent, i, b);
-            }
-            node = parent;
-        }
-        self.shorten();
-        for &(bx, id, level) in &orphans {
-            if level <= self.level[self.root as usize] {
-                self.insert_at_level(bx, id, level);
-                self.shorten();
-            } else {
-                self.reinsert_items_of(id, level - 1);
-            }
-        }
-        orphans.clear();
-        self.orphans = orphans;
-    }
-
-    /// Re-inserts every item below `node` (at `level`) as a leaf entry and frees the nodes.
-    fn reinsert_items_of(&mut self, node: u32, level: u8) {
-        let entries: Vec<(KeyBox, u32)> = (0..self.len_of(node))
-            .map(|i| (self.entry_box(node, i), self.id_at(node, i)))
-            .collect();
-        self.free_node(node);
-        for (bx, id) in entries {
-            if level == 0 {
-                self.insert_at_level(bx, id, 0);
-            } else {
-                self.reinsert_items_of(id, level - 1);
-            }
-        }
-    }
-
-    /// Makes the only child of an inner root the new root (repeatedly).
-    fn shorten(&mut self) {
-        while self.level[self.root as usize] > 0 && self.len_of(self.root) <= 1 {
-            let old = self.root;
-            if self.len_of(old) == 0 {
-                // An empty inner root becomes an empty leaf node.
-                self.level[old as usize] = 0;
-                let block = std::mem::replace(&mut self.box_block[old as usize], NONE);
-                if block != NONE {
-                    self.free_blocks.push(block);
-                }
-                return;
-            }
-            self.root = self.id_at(old, 0);
-            self.parent[self.root as usize] = NONE;
-            self.free_node(old);
-        }
-    }
-
     /// The item whose box contains the base cube `key` (the first found; leaves of an
     /// occupancy grid never overlap, so it is unique there).
     pub fn find_containing(&self, key: Key) -> Option<(u32, KeyBox)> {
@@ -506,7 +469,7 @@ impl RTree {
         let ids = self.child_ids(node);
         if self.level[node as usize] == 0 {
             return ids.iter().find_map(|&id| {
-                let b = self.item_boxes[id as usize];
+                let b = self.items[id as usize].bx;
                 b.contains_key(key).then_some((id, b))
             });
         }
@@ -548,7 +511,7 @@ impl RTree {
         let ids = self.child_ids(node);
         if self.level[node as usize] == 0 {
             for &id in ids {
-                let b = &self.item_boxes[id as usize];
+                let b = &self.items[id as usize].bx;
                 if b.intersects(query) && !visit(id, b) {
                     return false;
                 }
@@ -574,7 +537,7 @@ impl RTree {
         for i in 0..self.len_of(node) {
             let id = self.id_at(node, i);
             if leaf {
-                visit(id, &self.item_boxes[id as usize]);
+                visit(id, &self.items[id as usize].bx);
             } else {
                 self.items_in(id, visit);
             }
@@ -582,7 +545,7 @@ impl RTree {
     }
 
     /// Rebuilds the arena without holes: nodes renumbered depth first, items renumbered
-    /// `0 .. len` in tree order (spatially coherent). The tree's shape is unchanged. Returns
+    /// `0 .. len` in tree order (spatially coherent; values move with their items). The tree's shape is unchanged. Returns
     /// the map from old item id to new id (`u32::MAX` for ids not in the tree). `O(n)`.
     pub fn compact(&mut self) -> Vec<u32> {
         let mut out = Compacted {
@@ -592,10 +555,10 @@ impl RTree {
             level: Vec::with_capacity(self.num_nodes()),
             box_block: Vec::with_capacity(self.num_nodes()),
             inner_boxes: Vec::new(),
-            item_boxes: Vec::with_capacity(self.len),
+            items: Vec::with_capacity(self.len),
             item_leaf: Vec::with_capacity(self.len),
         };
-        let mut item_map = vec![NONE; self.item_boxes.len()];
+        let mut item_map = vec![NONE; self.items.len()];
         self.copy_node(self.root, NONE, &mut out, &mut item_map);
         self.ids = out.ids;
         self.count = out.count;
@@ -603,7 +566,7 @@ impl RTree {
         self.level = out.level;
         self.box_block = out.box_block;
         self.inner_boxes = out.inner_boxes;
-        self.item_boxes = out.item_boxes;
+        self.items = out.items;
         self.item_leaf = out.item_leaf;
         self.free_nodes = Vec::new();
         self.free_blocks = Vec::new();
@@ -631,8 +594,8 @@ impl RTree {
         for i in 0..n {
             let child = self.id_at(old, i);
             let new_child = if level == 0 {
-                let id = out.item_boxes.len() as u32;
-                out.item_boxes.push(self.item_boxes[child as usize]);
+                let id = out.items.len() as u32;
+                out.items.push(self.items[child as usize]);
                 out.item_leaf.push(new);
                 item_map[child as usize] = id;
                 id
@@ -698,6 +661,28 @@ impl RTree {
     }
 }
 
+/// Guttman's ChooseSubtree: the entry whose box needs the least enlargement to hold `bx`,
+/// ties to the smaller volume, then the first.
+#[inline]
+fn choose_subtree(boxes: &[KeyBox], bx: &KeyBox) -> usize {
+    let mut best = 0;
+    let mut best_key = u128::MAX;
+    for (i, b) in boxes.iter().enumerate() {
+        let (mut volume, mut grown) = (1u64, 1u64);
+        for a in 0..3 {
+            volume *= u64::from(b.hi[a] - b.lo[a]) + 1;
+            grown *= u64::from(b.hi[a].max(bx.hi[a]) - b.lo[a].min(bx.lo[a])) + 1;
+        }
+        // (enlargement, volume), compared at once.
+        let key = (u128::from(grown - volume) << 64) | u128::from(volume);
+        if key < best_key {
+            best_key = key;
+            best = i;
+        }
+    }
+    best
+}
+
 /// The arrays of a compacted tree under construction.
 struct Compacted {
     ids: Vec<u32>,
@@ -706,6 +691,6 @@ struct Compacted {
     level: Vec<u8>,
     box_block: Vec<u32>,
     inner_boxes: Vec<KeyBox>,
-    item_boxes: Vec<KeyBox>,
+    items: Vec<Item>,
     item_leaf: Vec<u32>,
 }

@@ -3,8 +3,8 @@
 use super::RTree;
 
 impl RTree {
-    /// Splits the overflowing `node` (M + 1 entries) into itself and a new sibling at the
-    /// same level; returns the sibling.
+    /// Splits the overflowing `node` (M entries and the spilled one) into itself and a new
+    /// sibling at the same level; returns the sibling.
     ///
     /// PickSeeds takes the pair with the largest `J = vol(R_ij) − vol(R_i) − vol(R_j)`;
     /// PickNext repeatedly assigns the entry with the largest `|d1 − d2|` to the group that
@@ -13,9 +13,10 @@ impl RTree {
     pub(super) fn split(&mut self, node: u32) -> u32 {
         let mut entries = std::mem::take(&mut self.scratch);
         entries.clear();
-        for i in 0..self.len_of(node) {
+        for i in 0..self.len_of(node).min(self.cap) {
             entries.push((self.entry_box(node, i), self.id_at(node, i)));
         }
+        entries.extend(self.spill.take());
         let n = entries.len();
         // PickSeeds.
         let (mut seed_a, mut seed_b, mut worst) = (0, 1, i64::MIN);
@@ -32,7 +33,9 @@ impl RTree {
         let level = self.level[node as usize];
         let sibling = self.alloc_node(level);
         self.count[node as usize] = 0;
-        let mut assigned = vec![false; n];
+        let mut assigned = std::mem::take(&mut self.assigned);
+        assigned.clear();
+        assigned.resize(n, false);
         assigned[seed_a] = true;
         assigned[seed_b] = true;
         let (mut box_a, mut box_b) = (entries[seed_a].0, entries[seed_b].0);
@@ -81,6 +84,7 @@ impl RTree {
             }
         }
         self.scratch = entries;
+        self.assigned = assigned;
         sibling
     }
 }

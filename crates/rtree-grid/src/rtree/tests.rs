@@ -93,3 +93,47 @@ proptest! {
         prop_assert_eq!(all, kept.len());
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// A batch removal (with ids not in the tree and repeats) leaves a valid tree holding
+    /// exactly the other items; item values follow their items through splits, removals
+    /// and compaction.
+    #[test]
+    fn batch_removal_keeps_the_rest(
+        order in prop::sample::select(vec![(1usize, 2usize), (2, 4), (3, 8), (4, 16)]),
+        cells in prop::collection::btree_set((0u16..12, 0u16..12, 0u16..4), 1..300),
+        remove_mask in prop::collection::vec(any::<bool>(), 300),
+    ) {
+        let (d, m) = order;
+        let mut tree = RTree::new(d, m).unwrap();
+        let cells: Vec<_> = cells.into_iter().collect();
+        for (i, &(x, y, z)) in cells.iter().enumerate() {
+            tree.store_item(i as u32, cube(x, y, z), 1000 + i as u32);
+            tree.insert(i as u32, cube(x, y, z));
+        }
+        let mut gone: Vec<u32> = (0..cells.len() as u32).filter(|&i| remove_mask[i as usize]).collect();
+        let kept: Vec<u32> = (0..cells.len() as u32).filter(|&i| !remove_mask[i as usize]).collect();
+        gone.extend(gone.clone()); // repeats are skipped
+        gone.push(cells.len() as u32 + 7); // so are ids never stored
+        tree.remove_many(&gone);
+        tree.check_invariants().map_err(TestCaseError::fail)?;
+        prop_assert_eq!(tree.len(), kept.len());
+        let mut left = Vec::new();
+        tree.for_each_item(&mut |id, b| left.push((id, *b)));
+        left.sort_unstable_by_key(|e| e.0);
+        let expected: Vec<_> = kept.iter().map(|&i| {
+            let (x, y, z) = cells[i as usize];
+            (i, cube(x, y, z))
+        }).collect();
+        prop_assert_eq!(&left, &expected);
+        for &i in &kept {
+            prop_assert_eq!(tree.item_value(i), Some(1000 + i));
+        }
+        let map = tree.compact();
+        for &i in &kept {
+            prop_assert_eq!(tree.item_value(map[i as usize]), Some(1000 + i));
+        }
+    }
+}
