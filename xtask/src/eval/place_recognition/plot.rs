@@ -1,15 +1,17 @@
-//! Precision–recall curves as PNG (plotters on an RGB buffer, written with `image`): recall on
-//! the horizontal axis, precision on the vertical, both 0–1 with grid lines every 0.1 and tick
-//! labels every 0.2 (a built-in 3 × 5 pixel font: plotters is built without a font backend).
-//! The legend (colour → method) is written in the report beside the picture.
+//! Precision–recall curves as PNG (through [`crate::render`]): recall on the horizontal axis,
+//! precision on the vertical, both 0–1 with grid lines every 0.1, tick and axis labels, and a
+//! legend strip (colour → method) below the chart. The report also names the colours in
+//! text beside the picture.
 
 use std::path::Path;
 
-use anyhow::{Context, Result, anyhow};
-use image::RgbImage;
+use anyhow::{Context, Result};
 use plotters::prelude::*;
 
-/// Colours of the curves in order, with their names for the legend.
+use crate::render::canvas::{self, FONT};
+use crate::render::legend::{self, Entry, Mark};
+
+/// Colours of the curves in order, with their names for the text legend.
 pub const PALETTE: [(&str, RGBColor); 12] = [
     ("blue", RGBColor(31, 91, 170)),
     ("orange", RGBColor(230, 120, 20)),
@@ -33,55 +35,67 @@ pub struct Curve {
     pub points: Vec<(f64, f64)>,
 }
 
-const WIDTH: u32 = 480;
-const HEIGHT: u32 = 400;
-const LEFT: i32 = 40;
-const BOTTOM: i32 = 30;
-const MARGIN: i32 = 12;
+/// Width of the picture and height of the chart above the legend, in pixels.
+const WIDTH: u32 = 520;
+const CHART_H: u32 = 420;
+/// Margin around the legend strip.
+const LEGEND_PAD: u32 = 10;
 
-/// Draws the curves and writes the PNG.
+/// The colour of curve `k`.
+fn color(k: usize) -> RGBColor {
+    PALETTE[k % PALETTE.len()].1
+}
+
+/// Draws the curves with axes and a legend and writes the PNG.
 pub fn write_pr_png(path: &Path, curves: &[Curve]) -> Result<()> {
-    let mut buffer = vec![255u8; (WIDTH * HEIGHT * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, (WIDTH, HEIGHT)).into_drawing_area();
-        let plot = root.margin(MARGIN, BOTTOM, LEFT, MARGIN);
+    let entries: Vec<Entry> = curves
+        .iter()
+        .enumerate()
+        .map(|(k, c)| Entry::new(c.label.as_str(), color(k), Mark::Line))
+        .collect();
+    let legend_w = WIDTH - 2 * LEGEND_PAD;
+    let legend_h = legend::height(&entries, legend_w);
+    let height = CHART_H + legend_h + LEGEND_PAD;
+    canvas::png(path, (WIDTH, height), |root| {
+        root.fill(&WHITE).context("drawing the picture")?;
+        let (plot, below) = root.split_vertically(CHART_H);
         let mut chart = ChartBuilder::on(&plot)
+            .margin(12)
+            .x_label_area_size(44)
+            .y_label_area_size(54)
             .build_cartesian_2d(0.0..1.0f64, 0.0..1.0f64)
-            .map_err(|e| anyhow!("plot: {e}"))?;
-        let grid = RGBColor(225, 225, 225);
-        for k in 0..=10 {
-            let v = f64::from(k) / 10.0;
-            for line in [[(v, 0.0), (v, 1.0)], [(0.0, v), (1.0, v)]] {
-                chart
-                    .draw_series(LineSeries::new(line, &grid))
-                    .map_err(|e| anyhow!("plot: {e}"))?;
-            }
-        }
+            .context("drawing the chart")?;
         chart
-            .draw_series(LineSeries::new(
-                [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (0.0, 0.0)],
-                &BLACK,
-            ))
-            .map_err(|e| anyhow!("plot: {e}"))?;
+            .configure_mesh()
+            .x_labels(6)
+            .y_labels(6)
+            .max_light_lines(1)
+            .bold_line_style(RGBColor(200, 200, 200))
+            .light_line_style(RGBColor(235, 235, 235))
+            .x_label_formatter(&|v| canvas::number(*v))
+            .y_label_formatter(&|v| canvas::number(*v))
+            .label_style((FONT, 15))
+            .axis_desc_style((FONT, 16))
+            .x_desc("recall")
+            .y_desc("precision")
+            .draw()
+            .context("drawing the axes")?;
         for (k, curve) in curves.iter().enumerate() {
-            let color = PALETTE[k % PALETTE.len()].1;
             chart
                 .draw_series(LineSeries::new(
                     curve.points.iter().copied(),
-                    color.stroke_width(2),
+                    color(k).stroke_width(2),
                 ))
-                .map_err(|e| anyhow!("plot: {e}"))?;
+                .context("drawing a curve")?;
         }
-        root.present().map_err(|e| anyhow!("plot: {e}"))?;
-    }
-    let mut img =
-        RgbImage::from_raw(WIDTH, HEIGHT, buffer).ok_or_else(|| anyhow!("plot: buffer size"))?;
-    tick_labels(&mut img);
-    img.save(path)
-        .with_context(|| format!("writing {}", path.display()))
+        legend::draw(
+            &below.margin(0, LEGEND_PAD, LEGEND_PAD, LEGEND_PAD),
+            &entries,
+        )
+    })
 }
 
-/// The legend of a picture: "method (colour)" in curve order.
+/// The legend of a picture in text: "method (colour)" in curve order.
 pub fn legend(curves: &[Curve]) -> String {
     curves
         .iter()
@@ -91,58 +105,32 @@ pub fn legend(curves: &[Curve]) -> String {
         .join(", ")
 }
 
-/// 3 × 5 glyphs of digits and '.', rows top to bottom, 3 bits per row.
-fn glyph(c: char) -> [u8; 5] {
-    match c {
-        '0' => [7, 5, 5, 5, 7],
-        '1' => [2, 6, 2, 2, 7],
-        '2' => [7, 1, 7, 4, 7],
-        '4' => [5, 5, 7, 1, 1],
-        '6' => [7, 4, 7, 5, 7],
-        '8' => [7, 5, 7, 5, 7],
-        '.' => [0, 0, 0, 0, 2],
-        _ => [0; 5],
-    }
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-/// Draws `text` at pixel `(x, y)` (top left), 2 × scaled.
-fn text(img: &mut RgbImage, x: i32, y: i32, text: &str) {
-    for (k, c) in text.chars().enumerate() {
-        for (row, bits) in glyph(c).iter().enumerate() {
-            for col in 0..3 {
-                if bits >> (2 - col) & 1 == 1 {
-                    for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                        let px = x + 8 * k as i32 + 2 * col + dx;
-                        let py = y + 2 * row as i32 + dy;
-                        if px >= 0
-                            && py >= 0
-                            && (px as u32) < img.width()
-                            && (py as u32) < img.height()
-                        {
-                            img.put_pixel(px as u32, py as u32, image::Rgb([0, 0, 0]));
-                        }
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// Tick labels 0, 0.2, …, 1 on both axes.
-fn tick_labels(img: &mut RgbImage) {
-    let (x0, x1) = (LEFT, WIDTH as i32 - MARGIN);
-    let (y0, y1) = (HEIGHT as i32 - BOTTOM, MARGIN);
-    for k in 0..=5 {
-        let v = f64::from(k) / 5.0;
-        let label = match k {
-            0 => "0".to_string(),
-            5 => "1".to_string(),
-            _ => format!("{v:.1}"),
-        };
-        let x = x0 + ((x1 - x0) as f64 * v) as i32;
-        let y = y0 + ((y1 - y0) as f64 * v) as i32;
-        let w = 8 * label.len() as i32;
-        text(img, x - w / 2, y0 + 6, &label);
-        text(img, x0 - w - 6, y - 5, &label);
+    /// Two curves give a picture taller than the chart (the legend strip), the same bytes
+    /// twice, and pixels in the first curve's colour.
+    #[test]
+    fn pr_png_is_deterministic_with_a_legend() {
+        let dir = tempfile::tempdir().unwrap();
+        let curves = vec![
+            Curve {
+                label: "scan context".into(),
+                points: vec![(0.0, 1.0), (0.5, 0.9), (1.0, 0.4)],
+            },
+            Curve {
+                label: "M2DP".into(),
+                points: vec![(0.0, 1.0), (0.3, 0.8), (0.9, 0.3)],
+            },
+        ];
+        let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
+        write_pr_png(&a, &curves).unwrap();
+        write_pr_png(&b, &curves).unwrap();
+        assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+        let img = image::open(&a).unwrap().to_rgb8();
+        assert!(img.height() > CHART_H);
+        let blue = PALETTE[0].1;
+        assert!(img.pixels().any(|p| p.0 == [blue.0, blue.1, blue.2]));
     }
 }
