@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{random_map, random_ray, rng, simpson};
+use common::{random_map, random_ray, random_rays, rng, simpson};
 use raypath_dct_map::{DctMap, MapRay, Outcome, Shape, moments, reference};
 use rustdct::DctPlanner;
 
@@ -85,9 +85,7 @@ fn closed_form_integral_equals_quadrature_and_eq_9_10() {
     let map = random_map(4, extent, Shape { l: 7, m: 5 });
     let small = random_map(5, extent, Shape { l: 4, m: 3 });
     let mut r = rng(6);
-    let mut rays: Vec<MapRay> = (0..30)
-        .map(|_| random_ray(&mut r, extent, Outcome::Super))
-        .collect();
+    let mut rays = random_rays(&mut r, extent, 30, &[Outcome::Super]);
     // Axis-parallel rays (ω = 0 for p = 0 or q = 0) and a diagonal one that is parallel to
     // some (p, −q) phase fronts.
     for (o, angle) in [

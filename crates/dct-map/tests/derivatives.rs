@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{random_map, random_ray, rng};
+use common::{random_map, random_ray, random_rays, rng};
 use raypath_dct_map::derivatives::{SubHessian, ray_derivatives};
 use raypath_dct_map::{DctMap, FitProblem, MapRay, Outcome, Shape, product_matrix, reference};
 
@@ -96,12 +96,8 @@ fn aggregated_objective_equals_the_sum_over_rays() {
     let map = random_map(17, extent, Shape { l: 4, m: 3 });
     let n = map.shape().len();
     let mut r = rng(18);
-    let rays: Vec<MapRay> = (0..30)
-        .map(|k| {
-            let outcome = [Outcome::Hit, Outcome::Super, Outcome::Hit, Outcome::Sub][k % 4];
-            random_ray(&mut r, extent, outcome)
-        })
-        .collect();
+    let outcomes = [Outcome::Hit, Outcome::Super, Outcome::Hit, Outcome::Sub];
+    let rays = random_rays(&mut r, extent, 30, &outcomes);
     let mut problem = FitProblem::new(extent, map.shape(), &rays).unwrap();
     problem.set_ridge_factor(0.0);
     problem.set_prior_path_density(0.0);
@@ -132,12 +128,8 @@ fn prior_is_the_integral_of_the_rate_and_enters_the_derivatives() {
     let a = map.coefficients().to_vec();
     let n = a.len();
     let mut r = rng(20);
-    let rays: Vec<MapRay> = (0..20)
-        .map(|k| {
-            let outcome = [Outcome::Hit, Outcome::Super, Outcome::Sub][k % 3];
-            random_ray(&mut r, extent, outcome)
-        })
-        .collect();
+    let outcomes = [Outcome::Hit, Outcome::Super, Outcome::Sub];
+    let rays = random_rays(&mut r, extent, 20, &outcomes);
     let mut problem = FitProblem::new(extent, map.shape(), &rays).unwrap();
     problem.set_ridge_factor(0.0);
     let rho = 0.7;

@@ -46,6 +46,7 @@
 mod aabb;
 mod error;
 mod grid;
+mod lane_dot;
 mod point_cloud;
 mod pose;
 mod range_image;
@@ -59,6 +60,7 @@ pub mod testing;
 pub use aabb::{Aabb2, Aabb3};
 pub use error::GeometryError;
 pub use grid::{Grid2, Grid3};
+pub use lane_dot::lane_dot;
 pub use point_cloud::PointCloud;
 pub use pose::{Pose2, Pose3, wrap_angle};
 pub use range_image::{

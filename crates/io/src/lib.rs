@@ -53,6 +53,7 @@
 
 mod detect;
 mod error;
+mod numbered_files;
 mod summary;
 
 pub mod carmen;

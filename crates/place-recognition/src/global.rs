@@ -19,6 +19,8 @@
 //!   cosine, also for a zero descriptor) and lists it first; the other scores are clamped to
 //!   `[−1, 1]`, so no other frame outranks it (an identical frame ties).
 
+use raypath_geometry::lane_dot;
+
 use crate::gist::{Gist, GistConfig};
 use crate::hog::{HogConfig, hog};
 use crate::{Candidate, Frame, ImageConfig, PlaceRecognizer, Result, frame_image};
@@ -28,8 +30,8 @@ pub fn cosine_similarity(a: &[f32], b: &[f32]) -> f64 {
     if a.len() != b.len() {
         return 0.0;
     }
-    let (na, nb) = (dot(a, a), dot(b, b));
-    cosine(dot(a, b), na, nb)
+    let (na, nb) = (lane_dot(a, a), lane_dot(b, b));
+    cosine(lane_dot(a, b), na, nb)
 }
 
 /// `ab / √(aa · bb)` clamped to `[−1, 1]`; 0 when a norm is 0.
@@ -40,24 +42,6 @@ fn cosine(ab: f32, aa: f32, bb: f32) -> f64 {
     } else {
         0.0
     }
-}
-
-/// Dot product with eight independent partial sums (vectorises; fixed order, deterministic).
-fn dot(a: &[f32], b: &[f32]) -> f32 {
-    let mut acc = [0.0f32; 8];
-    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
-    let tail: f32 = ca
-        .remainder()
-        .iter()
-        .zip(cb.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    for (x, y) in ca.zip(cb) {
-        for ((s, xv), yv) in acc.iter_mut().zip(x).zip(y) {
-            *s += xv * yv;
-        }
-    }
-    acc.iter().sum::<f32>() + tail
 }
 
 /// Which global descriptor.
@@ -118,7 +102,7 @@ impl GlobalDescriptorDb {
             .map(|j| {
                 let stored = &self.data[self.starts[j]..self.starts[j + 1]];
                 let score = if stored.len() == d.len() {
-                    cosine(dot(d, stored), dd, self.norms2[j])
+                    cosine(lane_dot(d, stored), dd, self.norms2[j])
                 } else {
                     0.0
                 };
@@ -147,7 +131,7 @@ impl PlaceRecognizer for GlobalDescriptorDb {
     }
 
     fn query(&self, description: &Vec<f32>, before: usize) -> Vec<Candidate> {
-        self.scores(description, dot(description, description), before)
+        self.scores(description, lane_dot(description, description), before)
     }
 
     fn query_stored(&self, index: usize, before: usize) -> Vec<Candidate> {
@@ -163,7 +147,7 @@ impl PlaceRecognizer for GlobalDescriptorDb {
     }
 
     fn insert(&mut self, description: Vec<f32>) {
-        self.norms2.push(dot(&description, &description));
+        self.norms2.push(lane_dot(&description, &description));
         self.data.extend_from_slice(&description);
         self.starts.push(self.data.len());
     }

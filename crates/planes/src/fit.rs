@@ -68,14 +68,31 @@ pub fn radial_sse(w: &Vector3<f64>, points: &[Vector3<f64>]) -> f64 {
 /// Fits a plane to endpoints `points` (sensor frame, metres) by minimizing the squared
 /// radial residuals; `None` for fewer than three points or a degenerate configuration.
 pub fn fit_plane(points: &[Vector3<f64>]) -> Option<PlaneFit> {
+    if points
+        .iter()
+        .any(|p| !p.iter().all(|x| x.is_finite()) || p.norm_squared() == 0.0)
+    {
+        return None;
+    }
+    fit_members(points)
+}
+
+/// The exact radial fit of the members of an extracted plane (Eq. 11.1–11.2): the
+/// sufficient-statistics solution of their [`PlaneStats`] (summed in the order of
+/// `points`), refined by [`refit`]. `None` for a degenerate configuration. The points are
+/// not checked (every extractor's rays are finite and non-zero).
+pub(crate) fn fit_members(points: &[Vector3<f64>]) -> Option<PlaneFit> {
     let mut stats = PlaneStats::default();
     for p in points {
-        if !p.iter().all(|x| x.is_finite()) || p.norm_squared() == 0.0 {
-            return None;
-        }
         stats.add(&PlaneStats::of_point(p));
     }
     let (w0, _) = stats.solve()?;
+    refit(w0, points)
+}
+
+/// The final refit every extractor gives its planes (Eq. 11.1–11.2): [`refine`] from
+/// `w0` with a relative step tolerance of 1e-6 and at most 20 iterations.
+pub(crate) fn refit(w0: Vector3<f64>, points: &[Vector3<f64>]) -> Option<PlaneFit> {
     refine(w0, points, 1e-6, 20)
 }
 

@@ -65,6 +65,8 @@ mod params;
 mod peac;
 mod ppe;
 mod stats;
+#[cfg(test)]
+mod test_scenes;
 mod tetromino;
 
 pub use error::PlaneError;

@@ -13,9 +13,8 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::error::PlaneError;
-use crate::fit::{PlaneFit, refine};
+use crate::fit::{PlaneFit, fit_members};
 use crate::ppe::{Plane, Segmentation};
-use crate::stats::PlaneStats;
 
 /// Parameters of [`msac`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -116,62 +115,35 @@ pub fn msac(
         }
         remaining = rest;
         let members: Vec<Vector3<f64>> = inliers.iter().map(|&i| points[i]).collect();
-        let stats = members.iter().fold(PlaneStats::default(), |mut s, p| {
-            s.add(&PlaneStats::of_point(p));
-            s
+        let fit = fit_members(&members).unwrap_or(PlaneFit {
+            w: if d.abs() > 0.0 { n / d } else { n },
+            sse: f64::INFINITY,
+            n: members.len(),
         });
-        let fit = stats
-            .solve()
-            .and_then(|(w0, _)| refine(w0, &members, 1e-6, 20))
-            .unwrap_or(PlaneFit {
-                w: if d.abs() > 0.0 { n / d } else { n },
-                sse: f64::INFINITY,
-                n: members.len(),
-            });
         planes.push(Plane {
             index: inliers,
             fit,
         });
     }
-    planes.sort_by(|a, b| {
-        b.index
-            .len()
-            .cmp(&a.index.len())
-            .then(a.index.cmp(&b.index))
-    });
-    let mut labels = vec![None; points.len()];
-    for (id, p) in planes.iter().enumerate() {
-        for &i in &p.index {
-            labels[i] = Some(id as u32);
-        }
-    }
     let steps = planes.len();
-    Ok(Segmentation {
+    Ok(Segmentation::from_planes(
         width,
         height,
-        labels,
+        points.len(),
         planes,
         steps,
-    })
+    ))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_scenes::wall_and_floor;
 
     #[test]
     fn finds_two_planes_and_partitions() {
         let (w, h) = (40, 30);
-        let mut pts = Vec::new();
-        for row in 0..h {
-            for col in 0..w {
-                let v = Vector3::new(1.0, (col as f64 - 19.5) * 0.03, 0.1 - row as f64 * 0.03)
-                    .normalize();
-                let t_wall = 3.0 / v.x;
-                let t_floor = if v.z < 0.0 { -1.0 / v.z } else { f64::INFINITY };
-                pts.push(v * t_wall.min(t_floor));
-            }
-        }
+        let pts = wall_and_floor(w, h, 0.03, 0.1);
         let params = MsacParams {
             max_distance_m: 0.01,
             remaining_fraction: 0.02,

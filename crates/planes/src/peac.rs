@@ -30,9 +30,8 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 use crate::error::PlaneError;
-use crate::fit::{PlaneFit, refine};
+use crate::fit::fit_members;
 use crate::ppe::{Plane, Segmentation};
-use crate::stats::PlaneStats;
 
 /// Parameters of [`peac`]. `Default` is the `synpeb` preset of [`PeacParams::synpeb`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -439,39 +438,16 @@ pub fn peac(
             m.push(k);
         }
     }
-    let mut planes: Vec<Plane> = members
+    let planes: Vec<Plane> = members
         .into_iter()
         .filter(|idx| idx.len() >= params.min_points.max(4))
         .filter_map(|index| {
             let pts: Vec<Vector3<f64>> = index.iter().map(|&i| points[i]).collect();
-            let mut stats = PlaneStats::default();
-            for p in &pts {
-                stats.add(&PlaneStats::of_point(p));
-            }
-            let (w0, _) = stats.solve()?;
-            let fit: PlaneFit = refine(w0, &pts, 1e-6, 20)?;
+            let fit = fit_members(&pts)?;
             Some(Plane { index, fit })
         })
         .collect();
-    planes.sort_by(|a, b| {
-        b.index
-            .len()
-            .cmp(&a.index.len())
-            .then(a.index.cmp(&b.index))
-    });
-    let mut labels = vec![None; n];
-    for (id, p) in planes.iter().enumerate() {
-        for &i in &p.index {
-            labels[i] = Some(id as u32);
-        }
-    }
-    Ok(Segmentation {
-        width,
-        height,
-        labels,
-        planes,
-        steps,
-    })
+    Ok(Segmentation::from_planes(width, height, n, planes, steps))
 }
 
 #[cfg(test)]
@@ -480,18 +456,7 @@ mod tests {
 
     /// A 60 × 40 grid looking at the wall x = 3 m and the floor z = −1 m.
     fn wall_and_floor() -> Vec<Vector3<f64>> {
-        let (w, h) = (60, 40);
-        let mut pts = Vec::new();
-        for row in 0..h {
-            for col in 0..w {
-                let v = Vector3::new(1.0, (col as f64 - 29.5) * 0.02, 0.2 - row as f64 * 0.02)
-                    .normalize();
-                let t_wall = 3.0 / v.x;
-                let t_floor = if v.z < 0.0 { -1.0 / v.z } else { f64::INFINITY };
-                pts.push(v * t_wall.min(t_floor));
-            }
-        }
-        pts
+        crate::test_scenes::wall_and_floor(60, 40, 0.02, 0.2)
     }
 
     #[test]

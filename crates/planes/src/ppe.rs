@@ -102,6 +102,38 @@ pub struct Segmentation {
 }
 
 impl Segmentation {
+    /// The segmentation of `rays` rays on a `width × height` grid into `planes` after
+    /// `steps` actions: the planes sorted largest first (ties by their ray indices), every
+    /// ray labelled with the plane that holds it. Each extractor ([`extract`],
+    /// [`crate::msac`], [`crate::peac`]) ends here.
+    pub(crate) fn from_planes(
+        width: usize,
+        height: usize,
+        rays: usize,
+        mut planes: Vec<Plane>,
+        steps: usize,
+    ) -> Self {
+        planes.sort_by(|a, b| {
+            b.index
+                .len()
+                .cmp(&a.index.len())
+                .then(a.index.cmp(&b.index))
+        });
+        let mut labels = vec![None; rays];
+        for (id, p) in planes.iter().enumerate() {
+            for &i in &p.index {
+                labels[i] = Some(id as u32);
+            }
+        }
+        Self {
+            width,
+            height,
+            labels,
+            planes,
+            steps,
+        }
+    }
+
     /// Sum of squared radial residuals over all planes (m²).
     pub fn sse(&self) -> f64 {
         self.planes.iter().map(|p| p.fit.sse).sum()

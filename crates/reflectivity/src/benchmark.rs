@@ -198,25 +198,35 @@ pub fn relative_errors(
     estimate: &[Pose2],
     relations: &[(usize, usize)],
 ) -> RelativeErrors {
+    let (t, r) = relation_error_lists(|i| reference.get(i), estimate, relations);
+    RelativeErrors {
+        translation_m: Stats::of(t),
+        rotation_rad: Stats::of(r),
+    }
+}
+
+/// The errors [`relation_error`] of the relations `(i, j)` whose four poses exist, in
+/// relation order: translations (m) and signed wrapped angles (rad). `reference(i)` is the
+/// reference pose of scan `i` (`None` skips the relations of the scan); `estimate` is
+/// index-aligned with it.
+pub fn relation_error_lists<'a>(
+    reference: impl Fn(usize) -> Option<&'a Pose2>,
+    estimate: &[Pose2],
+    relations: &[(usize, usize)],
+) -> (Vec<f64>, Vec<f64>) {
     let mut t = Vec::with_capacity(relations.len());
     let mut r = Vec::with_capacity(relations.len());
     for &(i, j) in relations {
-        let (Some(gi), Some(gj), Some(ei), Some(ej)) = (
-            reference.get(i),
-            reference.get(j),
-            estimate.get(i),
-            estimate.get(j),
-        ) else {
+        let (Some(gi), Some(gj), Some(ei), Some(ej)) =
+            (reference(i), reference(j), estimate.get(i), estimate.get(j))
+        else {
             continue;
         };
         let (dt, dr) = relation_error(gi, gj, ei, ej);
         t.push(dt);
         r.push(dr);
     }
-    RelativeErrors {
-        translation_m: Stats::of(t),
-        rotation_rad: Stats::of(r),
-    }
+    (t, r)
 }
 
 /// The error of one relation `(i, j)` (Kümmerle et al. 2009): the pose `δ_ref⁻¹ δ_est` with

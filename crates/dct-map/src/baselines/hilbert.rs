@@ -41,6 +41,7 @@ use faer::{ColMut, Mat, MatMut, MatRef, Par, Side};
 use rand::seq::index;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
+use raypath_geometry::lane_dot;
 
 use super::raster::OccupancyField;
 use super::{TrainingSet, distance_sq, rbf};
@@ -198,24 +199,6 @@ struct LogisticProblem<'a> {
     alpha: f64,
 }
 
-/// Dot product in eight lanes (vectorizable; fixed order, so deterministic).
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0; 8];
-    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
-    let tail: f64 = ca
-        .remainder()
-        .iter()
-        .zip(cb.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    for (x, y) in ca.zip(cb) {
-        for k in 0..8 {
-            acc[k] += x[k] * y[k];
-        }
-    }
-    acc.iter().sum::<f64>() + tail
-}
-
 impl LogisticProblem<'_> {
     /// Mean logistic loss + `(α/2)‖w‖²` at `x = (w, c)`, and its gradient in `grad`.
     fn evaluate(&self, x: &[f64], grad: &mut [f64]) -> f64 {
@@ -239,7 +222,7 @@ impl LogisticProblem<'_> {
             .map(|(block, ys)| {
                 let (mut loss, mut gc, mut u) = (0.0, 0.0, vec![0.0; m]);
                 for (col, y) in block.chunks_exact(m).zip(ys) {
-                    let margin = y * (dot(col, v) + c);
+                    let margin = y * (lane_dot(col, v) + c);
                     loss += softplus(-margin);
                     let r = -y * sigmoid(-margin) / n;
                     gc += r;

@@ -32,6 +32,19 @@ pub fn random_ray(r: &mut ChaCha8Rng, extent: [f64; 2], outcome: Outcome) -> Map
     MapRay::from_angle(o, angle, len, outcome)
 }
 
+/// `n` random rays ([`random_ray`]) from `r`, the `k`-th with outcome
+/// `outcomes[k % outcomes.len()]`.
+pub fn random_rays(
+    r: &mut ChaCha8Rng,
+    extent: [f64; 2],
+    n: usize,
+    outcomes: &[Outcome],
+) -> Vec<MapRay> {
+    (0..n)
+        .map(|k| random_ray(r, extent, outcomes[k % outcomes.len()]))
+        .collect()
+}
+
 /// Composite Simpson rule of `f` on `[0, len]` with `n` (even) intervals.
 pub fn simpson(f: impl Fn(f64) -> f64, len: f64, n: usize) -> f64 {
     let h = len / n as f64;

@@ -14,11 +14,13 @@
 //! the voxels segments cross (hit/miss grids): the same voxels, walked slab by slab along the
 //! major axis without per-voxel `t` comparisons.
 
+mod axis;
 mod grid;
 mod slab;
 #[cfg(test)]
 mod tests;
 
+use axis::{axis_setup, boundary_t};
 pub use slab::{SlabWalk, SlabWalkEnd};
 
 /// One cell crossed by a traversal: which cell, and the ray parameter interval (metres along
@@ -149,21 +151,6 @@ pub(crate) struct ClippedSegment<const N: usize> {
     pub clipped_at_end: bool,
 }
 
-/// Lattice coordinate of `origin + direction · t` along one axis (the arithmetic of
-/// `Grid::lattice_coords`), before flooring.
-#[inline]
-fn lattice_coordinate(origin: f64, direction: f64, t: f64, grid_origin: f64, cell: f64) -> f64 {
-    let point = origin + direction * t;
-    (point - grid_origin) / cell
-}
-
-/// Converts a float cell coordinate to a valid cell index (saturating, then clamped).
-#[inline]
-fn clamp_cell(value: f64, dim: usize) -> usize {
-    let max = dim.saturating_sub(1) as i64;
-    (value as i64).clamp(0, max) as usize
-}
-
 impl<const N: usize> Traversal<N> {
     /// The traversal that yields nothing.
     pub fn empty() -> Self {
@@ -195,62 +182,34 @@ impl<const N: usize> Traversal<N> {
         walk.cell_size = grid.cell_size;
         let mut stride = 1usize;
         for axis in 0..N {
-            let o = segment.origin[axis];
-            let d = segment.direction[axis];
-            let g = grid.origin[axis];
             let dim = grid.dims[axis];
-            let inv = 1.0 / d;
-            // Tiny (subnormal) components whose reciprocal overflows count as zero.
-            let moving = d != 0.0 && inv.is_finite();
-            let u_start = lattice_coordinate(o, d, segment.t_start, g, grid.cell_size);
-            let u_end = lattice_coordinate(o, d, segment.t_end, g, grid.cell_size);
-            // First cell: the one occupied just after the start.
-            let start = if moving && d < 0.0 {
-                clamp_cell(u_start.ceil() - 1.0, dim)
-            } else {
-                clamp_cell(u_start.floor(), dim)
-            };
-            // Last cell: `cell_of(endpoint)` (ties to the larger index), or the cell occupied
-            // just before the grid box cuts the segment.
-            let end = if segment.clipped_at_end && d > 0.0 {
-                clamp_cell(u_end.ceil() - 1.0, dim)
-            } else {
-                clamp_cell(u_end.floor(), dim)
-            };
-            // The two rules above disagree only when the coordinate does not change at all
-            // (the start and end lie on the same face, up to rounding): then the axis does not
-            // move and, like a zero component, uses the `cell_of` tie-break (the larger
-            // index) at both ends. Rounding can never reverse the direction of travel.
-            let (start, steps, step_up) = if !moving {
-                (start, 0, true)
-            } else if d > 0.0 {
-                (start, end.saturating_sub(start), true)
-            } else {
-                let start = start.max(end);
-                (start, start - end, false)
-            };
-            walk.cell[axis] = start;
-            walk.index += start * stride;
-            walk.remaining[axis] = steps;
-            walk.steps_left += steps;
-            walk.origin_offset[axis] = g - o;
-            walk.inv_direction[axis] = if moving { inv } else { 0.0 };
-            if step_up {
-                walk.boundary[axis] = (start + 1) as f64;
+            let setup = axis_setup(
+                segment.origin[axis],
+                segment.direction[axis],
+                grid.origin[axis],
+                grid.cell_size,
+                dim,
+                segment.t_start,
+                segment.t_end,
+                segment.clipped_at_end,
+            );
+            walk.cell[axis] = setup.start;
+            walk.index += setup.start * stride;
+            walk.remaining[axis] = setup.steps;
+            walk.steps_left += setup.steps;
+            walk.origin_offset[axis] = setup.offset;
+            walk.inv_direction[axis] = setup.inv;
+            walk.boundary[axis] = setup.boundary;
+            walk.t_next[axis] = setup.t_next;
+            if setup.up {
                 walk.boundary_step[axis] = 1.0;
                 walk.cell_step[axis] = 1;
                 walk.index_step[axis] = stride;
             } else {
-                walk.boundary[axis] = start as f64;
                 walk.boundary_step[axis] = -1.0;
                 walk.cell_step[axis] = usize::MAX; // −1, wrapping
                 walk.index_step[axis] = stride.wrapping_neg();
             }
-            walk.t_next[axis] = if steps == 0 {
-                f64::INFINITY
-            } else {
-                walk.boundary_t(axis)
-            };
             stride *= dim;
         }
         walk
@@ -260,9 +219,13 @@ impl<const N: usize> Traversal<N> {
     /// overflow also becomes `t_end`: the comparison is false).
     #[inline(always)]
     fn boundary_t(&self, axis: usize) -> f64 {
-        let t = (self.origin_offset[axis] + self.boundary[axis] * self.cell_size)
-            * self.inv_direction[axis];
-        if t < self.t_end { t } else { self.t_end }
+        boundary_t(
+            self.origin_offset[axis],
+            self.boundary[axis],
+            self.cell_size,
+            self.inv_direction[axis],
+            self.t_end,
+        )
     }
 
     /// The crossing of the current cell, then one step into the next cell along the axis

@@ -26,6 +26,7 @@
 //! parameters; on the rays of a KITTI local map (0.1 m voxels, about 120 per ray) the pole
 //! extractor's hit/miss counting takes about two thirds of the extraction time with it.
 
+use super::axis::{axis_setup, floor_i64};
 use crate::Grid3;
 use nalgebra::Point3;
 
@@ -88,38 +89,6 @@ struct Walk {
     left: [usize; 3],
     dt: [f64; 3],
     index_step: [usize; 3],
-}
-
-/// `floor(value)` as an integer, saturating (NaN gives 0): `value.floor() as i64` without
-/// a libm call.
-#[inline(always)]
-fn floor_i64(value: f64) -> i64 {
-    let truncated = value as i64;
-    if (truncated as f64) > value {
-        truncated.saturating_sub(1)
-    } else {
-        truncated
-    }
-}
-
-/// `floor(value)` clamped to a voxel index `0..dim` (as `Traversal::new`'s
-/// `clamp_cell(value.floor(), dim)`).
-#[inline(always)]
-fn floor_cell(value: f64, dim: usize) -> usize {
-    floor_i64(value).clamp(0, dim.saturating_sub(1) as i64) as usize
-}
-
-/// `ceil(value) − 1` clamped to `0..dim` (as `clamp_cell(value.ceil() − 1, dim)`).
-#[inline(always)]
-fn ceil_minus_one_cell(value: f64, dim: usize) -> usize {
-    let truncated = value as i64;
-    let ceil = if (truncated as f64) < value {
-        truncated.saturating_add(1)
-    } else {
-        truncated
-    };
-    ceil.saturating_sub(1)
-        .clamp(0, dim.saturating_sub(1) as i64) as usize
 }
 
 /// Where a [`SlabWalk::count`] ended.
@@ -207,51 +176,30 @@ impl SlabWalk {
         })
     }
 
-    /// The set-up of one axis (as [`Traversal`](crate::Traversal)'s).
+    /// The set-up of one axis (the one [`Traversal`](crate::Traversal) uses).
     #[inline(always)]
     fn axis(&self, axis: usize, o: f64, d: f64, t_start: f64, t_end: f64, clipped: bool) -> Axis {
-        let g = self.min[axis];
-        let dim = self.dims[axis];
         let stride = self.strides[axis];
-        let inv = 1.0 / d;
-        let moving = d != 0.0 && inv.is_finite();
-        let u_start = ((o + d * t_start) - g) / self.cell;
-        let u_end = ((o + d * t_end) - g) / self.cell;
-        let start = if moving && d < 0.0 {
-            ceil_minus_one_cell(u_start, dim)
-        } else {
-            floor_cell(u_start, dim)
-        };
-        let end = if clipped && d > 0.0 {
-            ceil_minus_one_cell(u_end, dim)
-        } else {
-            floor_cell(u_end, dim)
-        };
-        let (start, steps, up) = if !moving {
-            (start, 0, true)
-        } else if d > 0.0 {
-            (start, end.saturating_sub(start), true)
-        } else {
-            let start = start.max(end);
-            (start, start - end, false)
-        };
-        let (boundary, index_step) = if up {
-            ((start + 1) as f64, stride)
-        } else {
-            (start as f64, stride.wrapping_neg())
-        };
-        let inv = if moving { inv } else { 0.0 };
-        let t_next = if steps == 0 {
-            f64::INFINITY
-        } else {
-            boundary_t(g - o, boundary, self.cell, inv, t_end)
-        };
+        let setup = axis_setup(
+            o,
+            d,
+            self.min[axis],
+            self.cell,
+            self.dims[axis],
+            t_start,
+            t_end,
+            clipped,
+        );
         Axis {
-            start,
-            steps,
-            t_next,
-            dt: self.cell * inv.abs(),
-            index_step,
+            start: setup.start,
+            steps: setup.steps,
+            t_next: setup.t_next,
+            dt: self.cell * setup.inv.abs(),
+            index_step: if setup.up {
+                stride
+            } else {
+                stride.wrapping_neg()
+            },
         }
     }
 
@@ -315,13 +263,6 @@ impl SlabWalk {
         }
         Some(index)
     }
-}
-
-/// `t` of a boundary, clamped to the segment end (NaN from overflow becomes `t_end`).
-#[inline(always)]
-fn boundary_t(offset: f64, boundary: f64, cell: f64, inv: f64, t_end: f64) -> f64 {
-    let t = (offset + boundary * cell) * inv;
-    if t < t_end { t } else { t_end }
 }
 
 /// Fraction bits of the fixed-point side-axis positions.

@@ -8,7 +8,8 @@ use super::calib::{KittiCalib, read_calib};
 use super::labels::{PointLabel, check_label_count, read_labels};
 use super::poses::{read_poses, read_times};
 use super::velodyne::{read_velodyne, velodyne_point_count};
-use crate::{Error, Location, Result};
+use crate::numbered_files::numbered_bin_files;
+use crate::{Error, Result};
 
 /// A velodyne scan file and its frame number (the number in its name).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -192,25 +193,13 @@ impl Iterator for KittiScans<'_> {
 
 /// The `.bin` files of a velodyne directory, sorted by frame number.
 fn list_scans(dir: &Path) -> Result<Vec<ScanFile>> {
-    let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, Location::File, e))?;
-    let mut files = Vec::new();
-    for entry in entries {
-        let entry = entry.map_err(|e| Error::io(dir, Location::File, e))?;
-        let path = entry.path();
-        if path.extension().is_none_or(|e| e != "bin") {
-            continue;
-        }
-        let stem = path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let frame = stem.parse::<u64>().map_err(|_| Error::UnknownFormat {
-            path: path.clone(),
-            reason: "velodyne scan names must be frame numbers (000042.bin)".into(),
-        })?;
-        files.push(ScanFile { frame, path });
-    }
-    files.sort_by_key(|f| f.frame);
+    let files: Vec<ScanFile> = numbered_bin_files(
+        dir,
+        "velodyne scan names must be frame numbers (000042.bin)",
+    )?
+    .into_iter()
+    .map(|(frame, path)| ScanFile { frame, path })
+    .collect();
     if let Some(pair) = files.windows(2).find(|w| w[0].frame == w[1].frame) {
         return Err(Error::UnknownFormat {
             path: pair[1].path.clone(),

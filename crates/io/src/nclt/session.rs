@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 use raypath_geometry::PointCloud;
 
 use super::csv::{CovarianceTable, PoseTable, read_covariance, read_pose_csv};
-use super::velodyne::{HitsReader, RECORD_BYTES, read_velodyne_sync, utime_from_path};
+use super::velodyne::{HitsReader, RECORD_BYTES, read_velodyne_sync};
+use crate::numbered_files::numbered_bin_files;
 use crate::{Error, Location, Result};
 
 /// A `velodyne_sync` file and its timestamp.
@@ -273,22 +274,12 @@ fn is_date(text: &str) -> bool {
 
 /// The `.bin` files of a `velodyne_sync` directory, sorted by timestamp.
 fn list_sync(dir: &Path) -> Result<Vec<SyncFile>> {
-    let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, Location::File, e))?;
-    let mut files = Vec::new();
-    for entry in entries {
-        let entry = entry.map_err(|e| Error::io(dir, Location::File, e))?;
-        let path = entry.path();
-        if path.extension().is_none_or(|e| e != "bin") {
-            continue;
-        }
-        let utime = utime_from_path(&path).ok_or_else(|| Error::UnknownFormat {
-            path: path.clone(),
-            reason: "velodyne_sync file names must be microsecond timestamps \
-                     (1326030975726043.bin)"
-                .into(),
-        })?;
-        files.push(SyncFile { utime, path });
-    }
-    files.sort_by_key(|f| f.utime);
-    Ok(files)
+    let files = numbered_bin_files(
+        dir,
+        "velodyne_sync file names must be microsecond timestamps (1326030975726043.bin)",
+    )?;
+    Ok(files
+        .into_iter()
+        .map(|(utime, path)| SyncFile { utime, path })
+        .collect())
 }

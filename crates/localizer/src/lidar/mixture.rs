@@ -1,7 +1,36 @@
 //! The per-beam random-measurement mixture (AMCL's `z_rand`, Thrun et al. 2005, §6.3):
 //! `p̃(z_j) = (1 − ε) p(z_j | s, m) + ε q(z_j)`, evaluated in log space.
 
-use raypath_sensor_models::{Dimension, Reading, SensorModel, SensorRange};
+use raypath_sensor_models::{Dimension, Reading, ScanLikelihood, SensorModel, SensorRange};
+
+use super::LidarConfig;
+use crate::LocalizerError;
+
+/// The scan likelihood of a lidar adapter ([`Scan2Measurement`](super::Scan2Measurement),
+/// [`Scan3Measurement`](super::Scan3Measurement)): `model` under the random-measurement
+/// mixture of weight `config.random_weight`, every prepared ray used. Fails when `config`
+/// is invalid or, after that, when the sensor mounting is not finite (`mount_is_finite`;
+/// `mount` names the parameter in the error).
+pub(super) fn adapter_likelihood<D: Dimension, M: SensorModel<D>>(
+    model: M,
+    config: &LidarConfig,
+    mount_is_finite: bool,
+    mount: &'static str,
+) -> Result<ScanLikelihood<RandomMixture<M>>, LocalizerError> {
+    config.validate()?;
+    if !mount_is_finite {
+        return Err(LocalizerError::InvalidParameter {
+            name: mount,
+            reason: "must be finite".to_owned(),
+        });
+    }
+    let range = model.sensor_range();
+    Ok(ScanLikelihood::new(RandomMixture::new(
+        model,
+        range,
+        config.random_weight,
+    )))
+}
 
 /// `ln((1 − ε) e^{ln_p} + ε q)` given `ln_one_minus_eps = ln(1 − ε)` and `ln_eps_q = ln(ε q)`;
 /// never NaN (a NaN `ln_p` counts as `−∞`).

@@ -4,7 +4,7 @@ use raypath_geometry::{Pose2, Scan2};
 use raypath_sensor_models::{Planar, PreparedScan, ScanLikelihood, SensorModel};
 
 use super::LidarConfig;
-use super::mixture::RandomMixture;
+use super::mixture::{RandomMixture, adapter_likelihood};
 use crate::{LocalizerError, MeasurementModel};
 
 /// A 2-D scan prepared for weighting many particles: the kept beams' directions and
@@ -49,21 +49,14 @@ impl<M: SensorModel<Planar>> Scan2Measurement<M> {
         robot_from_laser: Pose2,
         config: LidarConfig,
     ) -> Result<Self, LocalizerError> {
-        config.validate()?;
-        if !robot_from_laser.is_finite() {
-            return Err(LocalizerError::InvalidParameter {
-                name: "robot_from_laser",
-                reason: "must be finite".to_owned(),
-            });
-        }
-        let range = model.sensor_range();
+        let scan_likelihood = adapter_likelihood(
+            model,
+            &config,
+            robot_from_laser.is_finite(),
+            "robot_from_laser",
+        )?;
         Ok(Self {
-            scan_likelihood: ScanLikelihood::new(RandomMixture::new(
-                model,
-                range,
-                config.random_weight,
-            ))
-            .with_beam_step(config.beam_step),
+            scan_likelihood: scan_likelihood.with_beam_step(config.beam_step),
             robot_from_laser,
             config,
         })

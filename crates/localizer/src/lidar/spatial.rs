@@ -5,7 +5,7 @@ use raypath_geometry::{PointCloud, Pose3, Range, Ray3};
 use raypath_sensor_models::{ScanLikelihood, SensorModel, Spatial};
 
 use super::LidarConfig;
-use super::mixture::RandomMixture;
+use super::mixture::{RandomMixture, adapter_likelihood};
 use crate::{LocalizerError, MeasurementModel};
 
 /// A 3-D scan prepared for weighting: the kept rays in the **sensor frame** and the
@@ -55,21 +55,15 @@ impl<M: SensorModel<Spatial>> Scan3Measurement<M> {
         robot_from_sensor: Pose3,
         config: LidarConfig,
     ) -> Result<Self, LocalizerError> {
-        config.validate()?;
-        if !robot_from_sensor.is_finite() {
-            return Err(LocalizerError::InvalidParameter {
-                name: "robot_from_sensor",
-                reason: "must be finite".to_owned(),
-            });
-        }
-        let range = model.sensor_range();
         // Subsampling happens in `prepare_*`; the inner adapter uses every prepared ray.
+        let scan_likelihood = adapter_likelihood(
+            model,
+            &config,
+            robot_from_sensor.is_finite(),
+            "robot_from_sensor",
+        )?;
         Ok(Self {
-            scan_likelihood: ScanLikelihood::new(RandomMixture::new(
-                model,
-                range,
-                config.random_weight,
-            )),
+            scan_likelihood,
             robot_from_sensor,
             config,
         })

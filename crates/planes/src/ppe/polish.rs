@@ -7,7 +7,7 @@ use nalgebra::Vector3;
 use rayon::prelude::*;
 
 use super::{Action, Entry, NONE, Plane, Segmentation, State, grid, queue};
-use crate::fit::refine;
+use crate::fit::refit;
 #[cfg(doc)]
 use crate::params::PpeParams;
 
@@ -269,35 +269,23 @@ impl State<'_> {
                 self.parent[id as usize] == id && cl.len as usize >= min_points
             })
             .collect();
-        let mut planes: Vec<Plane> = alive
+        let planes: Vec<Plane> = alive
             .into_par_iter()
             .filter_map(|id| {
                 let (w0, _) = self.clusters[id as usize].stats.solve()?;
                 let buf: Vec<Vector3<f64>> = self.members(id).map(|m| self.points[m]).collect();
-                let fit = refine(w0, &buf, 1e-6, 20)?;
+                let fit = refit(w0, &buf)?;
                 let mut index: Vec<usize> = self.members(id).collect();
                 index.sort_unstable();
                 Some(Plane { index, fit })
             })
             .collect();
-        planes.sort_by(|a, b| {
-            b.index
-                .len()
-                .cmp(&a.index.len())
-                .then(a.index.cmp(&b.index))
-        });
-        let mut labels = vec![None; self.points.len()];
-        for (id, p) in planes.iter().enumerate() {
-            for &i in &p.index {
-                labels[i] = Some(id as u32);
-            }
-        }
-        Segmentation {
-            width: self.width,
-            height: self.height,
-            labels,
+        Segmentation::from_planes(
+            self.width,
+            self.height,
+            self.points.len(),
             planes,
-            steps: self.steps,
-        }
+            self.steps,
+        )
     }
 }
