@@ -19,6 +19,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iostream>
@@ -30,6 +31,16 @@ using Clock = std::chrono::steady_clock;
 
 static double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Peak resident set of this process (VmHWM of /proc/self/status), KiB; 0 when unknown.
+static size_t peak_rss_kib() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::strtoull(line.c_str() + 6, nullptr, 10);
+  }
+  return 0;
 }
 
 int main(int argc, char** argv) {
@@ -109,8 +120,10 @@ int main(int argc, char** argv) {
       "{\"scans\": %zu, \"points\": %zu, \"insert_secs\": %.9f, \"prune_secs\": %.9f, "
       "\"nodes_built\": %zu, \"leaves_built\": %zu, \"nodes\": %zu, \"leaves\": %zu, "
       "\"inner_nodes\": %zu, \"memory_bytes\": %zu, \"occupied_leaves\": %zu, "
-      "\"visited_leaves\": %zu, \"access_secs\": %.9f, \"classes\": \"%s\"}\n",
+      "\"visited_leaves\": %zu, \"access_secs\": %.9f, \"peak_rss_kib\": %zu, "
+      "\"classes\": \"%s\"}\n",
       graph.size(), points, insert_secs, prune_secs, nodes_built, leaves_built, nodes, leaves,
-      nodes - leaves, memory, occupied_leaves, visited, access_secs, classes.c_str());
+      nodes - leaves, memory, occupied_leaves, visited, access_secs, peak_rss_kib(),
+      classes.c_str());
   return 0;
 }

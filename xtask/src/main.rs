@@ -71,6 +71,15 @@ enum Command {
     /// Check that no crate depends on a crate of a higher layer (layers from the crate table
     /// of docs/architecture.md, dependencies from `cargo metadata`); every crate must be listed.
     CheckLayers,
+    /// One workload of `eval memory` in a process of its own (prints one JSON line).
+    #[command(hide = true)]
+    MemoryProbe {
+        /// `<set>/thesis`, `<set>/equal`, `poles` or `ppe`.
+        workload: String,
+        /// The quick run's inputs.
+        #[arg(long)]
+        quick: bool,
+    },
 }
 
 #[derive(Subcommand)]
@@ -111,6 +120,7 @@ fn main() -> Result<()> {
             }
         },
         Command::Fuzz(options) => fuzz::run(&options),
+        Command::MemoryProbe { workload, quick } => eval::memory::probe(&workload, quick),
         Command::CheckLayers => {
             layers::run(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
         }

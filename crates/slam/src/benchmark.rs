@@ -14,12 +14,12 @@
 //! The relation set is written into every report so the numbers can be reproduced.
 
 use raypath_geometry::Pose2;
-use raypath_reflectivity::benchmark::{Stats, relation_error};
-use serde::Serialize;
+use raypath_reflectivity::benchmark::{Stats, relation_error, relation_error_lists};
+use serde::{Deserialize, Serialize};
 
 /// Mean and standard deviation of the relation errors: the JSON keys are a contract of
 /// `raypath slam --ground-truth`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ErrorSummary {
     /// Mean translational error, metres.
     pub trans_error_m: f64,
@@ -69,22 +69,13 @@ pub fn relation_errors(
     estimate: &[Pose2],
     relations: &[(usize, usize)],
 ) -> ErrorSummary {
-    let mut t = Vec::with_capacity(relations.len());
-    let mut r = Vec::with_capacity(relations.len());
-    for &(i, j) in relations {
-        let (Some(Some(gi)), Some(Some(gj)), Some(ei), Some(ej)) = (
-            reference.get(i),
-            reference.get(j),
-            estimate.get(i),
-            estimate.get(j),
-        ) else {
-            continue;
-        };
-        let (dt, dr) = relation_error(gi, gj, ei, ej);
-        t.push(dt);
-        r.push(dr.abs().to_degrees());
-    }
-    let (t, r) = (Stats::of(t), Stats::of(r));
+    let (t, r) = relation_error_lists(
+        |i| reference.get(i).and_then(Option::as_ref),
+        estimate,
+        relations,
+    );
+    let degrees = r.into_iter().map(|dr| dr.abs().to_degrees());
+    let (t, r) = (Stats::of(t), Stats::of(degrees));
     let nan_if_empty = |v: f64| if t.count == 0 { f64::NAN } else { v };
     ErrorSummary {
         trans_error_m: nan_if_empty(t.mean),

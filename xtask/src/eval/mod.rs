@@ -11,6 +11,7 @@ mod dct;
 mod geometry;
 mod io;
 mod mcl;
+pub mod memory;
 mod octomap;
 mod place_recognition;
 mod planes;
@@ -80,11 +81,12 @@ impl EvalContext {
     }
 
     /// The semi-synthetic KITTI drive of `kitti-poles/<sequence>` (its real trajectory, times
-    /// and pole map) cut to its first `scans` scans; `None` when the directory is absent.
+    /// and pole map) cut to its first `max_scans` scans (`None`: all); `None` when the
+    /// directory is absent.
     pub fn semi_kitti_config(
         &self,
         sequence: &str,
-        scans: usize,
+        max_scans: Option<usize>,
     ) -> Result<Option<raypath_sim::semi_kitti::SemiKittiConfig>> {
         let dir = self.data(&format!("kitti-poles/{sequence}"));
         if !dir.join("poses.txt").is_file() || !dir.join("poles.csv").is_file() {
@@ -97,7 +99,7 @@ impl EvalContext {
         )
         .with_context(|| format!("reading {}", dir.display()))?;
         config.sequence = sequence.to_owned();
-        config.max_scans = Some(scans);
+        config.max_scans = max_scans;
         Ok(Some(config))
     }
 
@@ -182,6 +184,11 @@ const EVALUATIONS: &[(&str, &str, EvalFn)] = &[
         octomap::run,
     ),
     (
+        "memory",
+        "peak resident memory of the Rtree grid (beside OctoMap), pole extraction and PPE",
+        memory::run,
+    ),
+    (
         "poles-kitti",
         "pole extraction and pole-based localization on semi-synthetic KITTI drives (Table 12.2)",
         poles_kitti::run,
@@ -227,6 +234,9 @@ const STAGED: &[&stages::Staged] = &[
     &polylines::STAGED,
     &dct::STAGED,
     &mcl::STAGED,
+    &poles_kitti::STAGED,
+    &poles_nclt::STAGED,
+    &slam::STAGED,
 ];
 
 fn staged(name: &str) -> Result<&'static stages::Staged> {

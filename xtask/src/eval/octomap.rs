@@ -30,6 +30,9 @@ mod real;
 mod summary;
 mod tables;
 
+pub(super) use self::data::Dataset;
+pub(super) use self::peer::{PeerRun, build as build_peer, run as run_peer};
+
 use std::fmt::Write;
 
 use anyhow::{Result, bail};
@@ -37,7 +40,6 @@ use serde_json::{Value, json};
 
 use super::stages::{self, Staged, UnitResults};
 use super::{EvalContext, EvalReport, comparable};
-use data::Dataset;
 use measure::{SetInfo, SetResult};
 use summary::Summary;
 
@@ -93,7 +95,7 @@ fn units(ctx: &EvalContext) -> Result<Vec<String>> {
 }
 
 /// The scans of data set `unit`, written as a `.graph`; `None` when its data are absent.
-fn dataset(ctx: &EvalContext, unit: &str) -> Result<Option<Dataset>> {
+pub(super) fn dataset(ctx: &EvalContext, unit: &str) -> Result<Option<Dataset>> {
     let q = ctx.quick;
     let stride = if q { 4 } else { 1 };
     match unit {
@@ -335,6 +337,7 @@ mod tests {
                 memory_bytes: 2000,
                 occupied_leaves: 7,
                 access_secs: 0.002,
+                peak_rss_kib: Some(4096),
                 classes: String::new(),
             }),
             agreement: Some((0.9, 0.95)),

@@ -39,6 +39,17 @@ pub struct Staged {
     pub report: fn(&EvalContext, &UnitResults) -> Result<EvalReport>,
 }
 
+/// Reads `value[key]` of a unit result as `T` (an error names the key).
+pub fn field<T: serde::de::DeserializeOwned>(value: &Value, key: &str) -> Result<T> {
+    serde_json::from_value(value[key].clone()).with_context(|| format!("reading {key:?}"))
+}
+
+/// `value[key]` of a unit result as a number; NaN where JSON holds none (`null`: a
+/// non-finite figure written with `json!`).
+pub fn number(value: &Value, key: &str) -> f64 {
+    value[key].as_f64().unwrap_or(f64::NAN)
+}
+
 /// Shard `index` (1-based) of `count`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Shard {

@@ -40,7 +40,7 @@ fn run_scan(path: &Path, method: Method) -> Result<Scan> {
     hoover_score(&gt, &seg, secs, None)
 }
 
-fn pcd_files(dir: &Path) -> Vec<PathBuf> {
+pub(super) fn pcd_files(dir: &Path) -> Vec<PathBuf> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
         .map(|it| {
             it.filter_map(|e| e.ok().map(|e| e.path()))

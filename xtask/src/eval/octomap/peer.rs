@@ -29,6 +29,9 @@ pub struct PeerRun {
     pub occupied_leaves: usize,
     /// Time to visit all leaves and test occupancy, seconds.
     pub access_secs: f64,
+    /// Peak resident set of the driver process (`VmHWM`), KiB; absent from older drivers.
+    #[serde(default)]
+    pub peak_rss_kib: Option<u64>,
     /// Classification of the query points: u, f, o.
     #[serde(default, skip_serializing)]
     pub classes: String,

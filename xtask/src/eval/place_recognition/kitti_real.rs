@@ -123,7 +123,7 @@ fn load(ctx: &EvalContext) -> Result<Loaded> {
 /// Intensity images of simulated scans at the poses of the real frames (frames 0–9 of
 /// `kitti-poles/NN`).
 fn simulated_images(ctx: &EvalContext, seq: &str) -> Result<Option<Vec<GrayImage>>> {
-    let Some(mut config) = ctx.semi_kitti_config(seq, FRAMES)? else {
+    let Some(mut config) = ctx.semi_kitti_config(seq, Some(FRAMES))? else {
         return Ok(None);
     };
     config.labels = false;

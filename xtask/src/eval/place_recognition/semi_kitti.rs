@@ -9,13 +9,13 @@ use std::fmt::Write;
 use std::ops::Range;
 use std::sync::Arc;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use rayon::prelude::*;
 use raypath_geometry::{PointCloud, Pose3};
 use raypath_place_recognition::{BinaryVocabulary, EquirectConfig, equirectangular};
 use raypath_sim::datasets::DEFAULT_SEED;
 use raypath_sim::scene3::Scene3;
-use raypath_sim::semi_kitti::{SemiKittiConfig, SemiKittiDrive};
+use raypath_sim::semi_kitti::SemiKittiDrive;
 use serde_json::{Value, json};
 
 use super::camera::{Lighting, camera_image};
@@ -143,18 +143,10 @@ fn run_plan(
     plan: &Plan,
     vocabulary: Option<&Arc<BinaryVocabulary>>,
 ) -> Result<Option<Outcome>> {
-    let dir = ctx.data(&format!("kitti-poles/{}", plan.sequence));
-    if !dir.join("poses.txt").exists() {
+    let Some(mut config) = ctx.semi_kitti_config(plan.sequence, None)? else {
         return Ok(None);
-    }
+    };
     let started = std::time::Instant::now();
-    let mut config = SemiKittiConfig::from_files(
-        &dir.join("poses.txt"),
-        &dir.join("times.txt"),
-        &dir.join("poles.csv"),
-    )
-    .with_context(|| format!("reading {}", dir.display()))?;
-    config.sequence = plan.sequence.to_owned();
     config.stride = plan.stride;
     config.labels = false;
     if let Some(last) = plan

@@ -118,7 +118,7 @@ fn simulated(
     sequence: &str,
     moving: bool,
 ) -> Result<Option<(LabelledLocalMap, Vec<ReferencePole>)>> {
-    let Some(mut config) = ctx.semi_kitti_config(sequence, FRAMES)? else {
+    let Some(mut config) = ctx.semi_kitti_config(sequence, Some(FRAMES))? else {
         return Ok(None);
     };
     config.sweep_motion = moving;

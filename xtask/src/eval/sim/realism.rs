@@ -136,7 +136,7 @@ fn sequence_stats(
     frames: usize,
 ) -> Result<Option<(Stats, Stats, usize)>> {
     let real_dir = ctx.data(&format!("kitti/sequences/{seq}"));
-    let config = match ctx.semi_kitti_config(seq, frames)? {
+    let config = match ctx.semi_kitti_config(seq, Some(frames))? {
         Some(config) if real_dir.join("velodyne").is_dir() => config,
         _ => {
             eprintln!("sim: real KITTI {seq} or its pole map is absent, skipping it");
