@@ -237,6 +237,7 @@ const STAGED: &[&stages::Staged] = &[
     &poles_kitti::STAGED,
     &poles_nclt::STAGED,
     &slam::STAGED,
+    &synpeb::STAGED,
 ];
 
 fn staged(name: &str) -> Result<&'static stages::Staged> {

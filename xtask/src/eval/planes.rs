@@ -137,30 +137,41 @@ pub fn msac_grid(dist: &[f64], remaining: &[f64], min_points: &[usize]) -> Vec<(
 }
 
 /// The scores of one segmented scan under the Hoover et al. protocol (T = 0.8).
-#[derive(Debug, Default, Clone)]
+#[derive(Debug, Default, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct HooverScore {
     /// Fraction of correctly detected ground-truth planes, %.
+    #[serde(with = "super::stages::float")]
     pub f: f64,
     /// Rays of the correctly detected planes over the rays of all ground-truth planes, %.
+    #[serde(with = "super::stages::float")]
     pub k: f64,
     /// Per-ray radial RMSE of the extracted planes with an RMSE below 10 m, mm.
+    #[serde(with = "super::stages::float")]
     pub rmse_mm: f64,
     /// Mean angle deviation over adjacent, correctly detected ground-truth pairs, degrees
     /// (NaN without ground-truth angles or without such a pair).
+    #[serde(with = "super::stages::float")]
     pub alpha_deg: f64,
     /// Over-segmented ground-truth planes.
+    #[serde(with = "super::stages::float")]
     pub n_o: f64,
     /// Under-segmentations.
+    #[serde(with = "super::stages::float")]
     pub n_u: f64,
     /// Missed ground-truth planes.
+    #[serde(with = "super::stages::float")]
     pub n_m: f64,
     /// Spurious (noise) planes.
+    #[serde(with = "super::stages::float")]
     pub n_s: f64,
     /// Ground-truth planes.
+    #[serde(with = "super::stages::float")]
     pub gt: f64,
     /// Extracted planes.
+    #[serde(with = "super::stages::float")]
     pub planes: f64,
     /// Extraction time, s.
+    #[serde(with = "super::stages::float")]
     pub secs: f64,
 }
 

@@ -9,14 +9,21 @@
 //! n_o, n_u, n_m, n_s and the extraction time; means over the scans of a split. The RMSE is
 //! also given under the reference implementation's averaging (`ploteval.m` drops scans whose
 //! RMSE exceeds 20 mm from the mean).
+//!
+//! In stages (`--shard i/n`, `merge`): one unit per noise level of the generated test split
+//! (`generated/<σ>`), the real SynPEB sample (`real-sample`) and the real KITTI and Ouster
+//! scans (`real-scans`); the page is drawn from their results alone.
 
 use std::path::{Path, PathBuf};
+
+use serde_json::{Value, json as value};
 
 use anyhow::{Context, Result};
 use raypath_io::pcd::{ReadOptions, read_pcd};
 use raypath_planes::{MsacParams, PeacParams, PpeParams};
 
 use super::planes::{HooverScore as Scan, Method, hoover_score, mean};
+use super::stages::{self, Staged, UnitResults, field};
 use super::{EvalContext, EvalReport, median};
 use crate::table::{Table, fmt_num};
 
@@ -91,7 +98,7 @@ fn row(t: &mut Table, name: &str, scans: &[Scan]) {
     ]);
 }
 
-fn json(scans: &[Scan]) -> serde_json::Value {
+fn json(scans: &[Scan]) -> Value {
     let mut secs: Vec<f64> = scans.iter().map(|s| s.secs).collect();
     serde_json::json!({
         "scans": scans.len(),
@@ -104,11 +111,85 @@ fn json(scans: &[Scan]) -> serde_json::Value {
     })
 }
 
-/// Runs the evaluation.
+/// The stages of `eval synpeb`.
+pub const STAGED: Staged = Staged {
+    name: NAME,
+    units,
+    run_unit,
+    report,
+};
+
+/// Runs the evaluation (every unit, then the report).
 pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
+    stages::run_all(&STAGED, ctx)
+}
+
+/// The noise levels of the generated split, the real sample, the real scans.
+fn units(_ctx: &EvalContext) -> Result<Vec<String>> {
+    Ok(LEVELS
+        .iter()
+        .map(|level| format!("generated/{level}"))
+        .chain(["real-sample".to_owned(), "real-scans".to_owned()])
+        .collect())
+}
+
+/// The scores of the three methods on `files` (PPE with `ppe`).
+fn run_methods(ctx: &EvalContext, files: &[PathBuf], ppe: PpeParams, label: &str) -> Result<Value> {
+    let bar = ctx.progress(files.len() as u64, label);
+    let (mut scans, mut peacs, mut msacs) = (Vec::new(), Vec::new(), Vec::new());
+    for f in files {
+        scans.push(run_scan(f, Method::Ppe(ppe))?);
+        peacs.push(run_scan(f, Method::Peac(PeacParams::synpeb()))?);
+        msacs.push(run_scan(f, Method::Msac(MsacParams::synpeb()))?);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    Ok(value!({ "ppe": scans, "peac": peacs, "msac": msacs }))
+}
+
+/// Measures one unit.
+fn run_unit(ctx: &EvalContext, unit: &str) -> Result<Value> {
+    if let Some(level) = unit.strip_prefix("generated/") {
+        let name = format!("synpeb-{level}");
+        let params = PpeParams::preset(&name).with_context(|| format!("no PPE preset {name}"))?;
+        let set = crate::generate::ensure("synpeb", ctx.quick)?;
+        let per_level = if ctx.quick { 2 } else { usize::MAX };
+        let files: Vec<PathBuf> = pcd_files(&set.join("test").join(level))
+            .into_iter()
+            .take(per_level)
+            .collect();
+        return run_methods(ctx, &files, params, &format!("σ {level} cm"));
+    }
+    match unit {
+        "real-sample" => {
+            let sample = ctx.data(SAMPLE);
+            if sample.is_file() {
+                run_methods(ctx, &[sample], PpeParams::synpeb(), "real sample")
+            } else {
+                Ok(value!({ "absent": sample.display().to_string() }))
+            }
+        }
+        "real-scans" => {
+            let (markdown, json) = real::run(ctx)?;
+            Ok(value!({ "markdown": markdown, "json": json }))
+        }
+        _ => anyhow::bail!("{unit:?} is not a unit of {NAME}"),
+    }
+}
+
+/// The real SynPEB sample under `RAYPATH_DATA`.
+const SAMPLE: &str = "planes/synpeb-sample-100x100.pcd";
+
+/// The page from the unit results.
+fn report(ctx: &EvalContext, results: &UnitResults) -> Result<EvalReport> {
     let params = PpeParams::synpeb();
-    let per_level = if ctx.quick { 2 } else { usize::MAX };
-    let set = crate::generate::ensure("synpeb", ctx.quick)?;
+    let unit = |name: &str| {
+        results
+            .iter()
+            .find(|(u, _)| u == name)
+            .map(|(_, v)| v)
+            .with_context(|| format!("no result of unit {name}"))
+    };
     let mut headers = vec![
         "data",
         "scans",
@@ -129,7 +210,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         "min rays",
         "refine rounds",
     ]);
-    let mut results = serde_json::Map::new();
+    let mut results_json = serde_json::Map::new();
     let mut level_scans = Vec::new();
     let msac_params = MsacParams::synpeb();
     let peac_params = PeacParams::synpeb();
@@ -145,19 +226,10 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             level_params.min_points.to_string(),
             level_params.refine_rounds.to_string(),
         ]);
-        let files: Vec<PathBuf> = pcd_files(&set.join("test").join(level))
-            .into_iter()
-            .take(per_level)
-            .collect();
-        let bar = ctx.progress(files.len() as u64, &format!("σ {level} cm"));
-        let (mut scans, mut peacs, mut msacs) = (Vec::new(), Vec::new(), Vec::new());
-        for f in &files {
-            scans.push(run_scan(f, Method::Ppe(level_params))?);
-            peacs.push(run_scan(f, Method::Peac(peac_params))?);
-            msacs.push(run_scan(f, Method::Msac(msac_params))?);
-            bar.inc(1);
-        }
-        bar.finish_and_clear();
+        let measured = unit(&format!("generated/{level}"))?;
+        let scans: Vec<Scan> = field(measured, "ppe")?;
+        let peacs: Vec<Scan> = field(measured, "peac")?;
+        let msacs: Vec<Scan> = field(measured, "msac")?;
         for (method, list) in [("PPE", &scans), ("PEAC-style", &peacs), ("MSAC", &msacs)] {
             row(
                 &mut table,
@@ -165,40 +237,30 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
                 list,
             );
         }
-        results.insert(format!("generated_{level}"), json(&scans));
-        results.insert(format!("peac_generated_{level}"), json(&peacs));
-        results.insert(format!("msac_generated_{level}"), json(&msacs));
+        results_json.insert(format!("generated_{level}"), json(&scans));
+        results_json.insert(format!("peac_generated_{level}"), json(&peacs));
+        results_json.insert(format!("msac_generated_{level}"), json(&msacs));
         level_scans.push((level, scans, peacs));
     }
-    let sample = ctx.data("planes/synpeb-sample-100x100.pcd");
-    let sample_note = if sample.is_file() {
-        let s = run_scan(&sample, Method::Ppe(params))?;
-        row(
-            &mut table,
-            "PPE, real SynPEB sample 100 × 100",
-            std::slice::from_ref(&s),
-        );
-        results.insert("real_sample".into(), json(std::slice::from_ref(&s)));
-        let p = run_scan(&sample, Method::Peac(peac_params))?;
-        row(
-            &mut table,
-            "PEAC-style, real SynPEB sample 100 × 100",
-            std::slice::from_ref(&p),
-        );
-        results.insert("peac_real_sample".into(), json(std::slice::from_ref(&p)));
-        let m = run_scan(&sample, Method::Msac(msac_params))?;
-        row(
-            &mut table,
-            "MSAC, real SynPEB sample 100 × 100",
-            std::slice::from_ref(&m),
-        );
-        results.insert("msac_real_sample".into(), json(std::slice::from_ref(&m)));
-        String::new()
-    } else {
-        format!(
-            "The real sample `{}` is absent (see datasets/README.md).\n\n",
-            sample.display()
-        )
+    let sample = unit("real-sample")?;
+    let sample_note = match sample["absent"].as_str() {
+        None => {
+            for (method, key, out) in [
+                ("PPE", "ppe", "real_sample"),
+                ("PEAC-style", "peac", "peac_real_sample"),
+                ("MSAC", "msac", "msac_real_sample"),
+            ] {
+                let scans: Vec<Scan> = field(sample, key)?;
+                row(
+                    &mut table,
+                    &format!("{method}, real SynPEB sample 100 × 100"),
+                    &scans,
+                );
+                results_json.insert(out.into(), json(&scans));
+            }
+            String::new()
+        }
+        Some(path) => format!("The real sample `{path}` is absent (see datasets/README.md).\n\n"),
     };
     let (at2, peac2) = level_scans
         .iter()
@@ -278,9 +340,11 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         format!("{} (PPE/PEAC = {:.0}×)", fmt_num(peac_t2, 3), t2 / peac_t2),
         "–".into(),
     ]);
-    let (real_md, real_json) = real::run(ctx)?;
+    let real_scans = unit("real-scans")?;
+    let real_md: String = field(real_scans, "markdown")?;
+    let real_json = real_scans["json"].clone();
     let headline = headline(&real_json, f2, t2, peac_t2);
-    results.insert("real_scans".into(), real_json);
+    results_json.insert("real_scans".into(), real_json);
     let threads = rayon::current_num_threads();
     let markdown = format!(
         "PPE (`raypath_planes::extract` with the preset of each noise level, below), the \
@@ -337,7 +401,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
             "init_tol_m": peac_params.init_tol_m, "merge_tol_m": peac_params.merge_tol_m,
             "discontinuity_rel": peac_params.discontinuity_rel, "min_points": peac_params.min_points,
             "refine_sigmas": peac_params.refine_sigmas},
-            "results": results}),
+            "results": results_json}),
         headline,
     })
 }
@@ -402,7 +466,7 @@ fn yes_no(b: bool) -> &'static str {
 
 /// The page's headline: PPE and PEAC-style on the held-out real KITTI frames, then PPE on the
 /// generated SynPEB-style scans at σ = 2 cm.
-fn headline(real: &serde_json::Value, f2: f64, t2: f64, peac_t2: f64) -> Option<String> {
+fn headline(real: &Value, f2: f64, t2: f64, peac_t2: f64) -> Option<String> {
     let held =
         |method: &str, key: &str| real["kitti"][format!("{method}_kitti_held_out")][key].as_f64();
     let real_part = match (held("ppe", "f1"), held("peac", "f1"), held("msac", "f1")) {
@@ -496,5 +560,43 @@ mod tests {
         );
         assert!(h.contains("not like for like"), "{h}");
         assert!(headline(&serde_json::json!({}), f64::NAN, 0.0, 0.0).is_none());
+    }
+
+    /// The page from known unit results (two scans per level, the sample absent): every
+    /// level has its three rows, the σ = 2 cm aims read its scans, the real section and
+    /// its JSON come through, and a NaN angle survives the unit JSON.
+    #[test]
+    fn report_from_known_units() {
+        let mut with_nan = scan(70.0, 15.0, 1.0);
+        with_nan.alpha_deg = f64::NAN;
+        let methods = value!({
+            "ppe": [with_nan, scan(80.0, 16.0, 3.0)],
+            "peac": [scan(30.0, 20.0, 0.1), scan(40.0, 22.0, 0.1)],
+            "msac": [scan(10.0, 30.0, 0.5), scan(12.0, 31.0, 0.5)],
+        });
+        let back: Vec<Scan> = field(&methods, "ppe").unwrap();
+        assert!(back[0].alpha_deg.is_nan());
+        let mut results: Vec<(String, Value)> = LEVELS
+            .iter()
+            .map(|l| (format!("generated/{l}"), methods.clone()))
+            .collect();
+        results.push((
+            "real-sample".into(),
+            value!({ "absent": "/nowhere/sample.pcd" }),
+        ));
+        results.push((
+            "real-scans".into(),
+            value!({ "markdown": "## Real scans\n", "json": { "kitti": {} } }),
+        ));
+        let ctx = EvalContext::scratch(&std::env::temp_dir().join("raypath-synpeb-report-test"));
+        let page = report(&ctx, &results).unwrap();
+        let md = &page.markdown;
+        assert!(md.contains("| PPE, generated test, σ = 2.0 cm "), "{md}");
+        assert!(md.contains("| MSAC, generated test, σ = 4.0 cm "), "{md}");
+        assert!(md.contains("`/nowhere/sample.pcd` is absent"), "{md}");
+        assert!(md.contains("| f ≥ 73.6 %"), "{md}");
+        assert!(md.ends_with("## Real scans\n"), "{md}");
+        assert_eq!(page.json["results"]["generated_2.0"]["scans"], 2);
+        assert!(page.headline.unwrap().contains("PPE f 75.0 % at 2.00 s"));
     }
 }
