@@ -116,11 +116,13 @@ impl<const TAG_BITS: u32> RobinTable<TAG_BITS> {
 
     /// The first entry under `home` for which `accept(id, tag)` holds.
     #[inline]
-    pub(crate) fn find(
-        &self,
-        home: usize,
-        mut accept: impl FnMut(u32, u16) -> bool,
-    ) -> Option<u32> {
+    pub(crate) fn find(&self, home: usize, accept: impl FnMut(u32, u16) -> bool) -> Option<u32> {
+        self.position(home, accept).map(|i| self.slots[i].id())
+    }
+
+    /// The slot of the first entry under `home` for which `accept(id, tag)` holds.
+    #[inline]
+    fn position(&self, home: usize, mut accept: impl FnMut(u32, u16) -> bool) -> Option<usize> {
         if self.len == 0 {
             return None;
         }
@@ -134,7 +136,7 @@ impl<const TAG_BITS: u32> RobinTable<TAG_BITS> {
                 return None;
             }
             if di == d && accept(slot.id(), Self::tag(&slot)) {
-                return Some(slot.id());
+                return Some(i);
             }
             i = self.next(i);
             d += 1;
@@ -189,28 +191,10 @@ impl<const TAG_BITS: u32> RobinTable<TAG_BITS> {
 
     /// Removes the first entry under `home` for which `matches(id, tag)` holds; returns
     /// whether one was found.
-    pub(crate) fn remove(
-        &mut self,
-        home: usize,
-        mut matches: impl FnMut(u32, u16) -> bool,
-    ) -> bool {
-        if self.len == 0 {
+    pub(crate) fn remove(&mut self, home: usize, matches: impl FnMut(u32, u16) -> bool) -> bool {
+        let Some(mut i) = self.position(home, matches) else {
             return false;
-        }
-        let mut i = home;
-        let mut d = 0u16;
-        loop {
-            let slot = self.slots[i];
-            let di = Self::disp(&slot);
-            if di == Self::FREE || di < d {
-                return false;
-            }
-            if di == d && matches(slot.id(), Self::tag(&slot)) {
-                break;
-            }
-            i = self.next(i);
-            d += 1;
-        }
+        };
         // Backward shift: pull the following displaced entries one slot closer to home.
         loop {
             let j = self.next(i);
