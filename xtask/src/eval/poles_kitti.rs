@@ -8,10 +8,13 @@
 //!
 //! * Data: the **real** trajectories and **real** pole maps of KITTI odometry sequences
 //!   00–07 (`RAYPATH_DATA/kitti-poles/NN`; missing ones are skipped with a note). Each drive
-//!   is simulated in memory ([`SemiKittiDrive`]: the street world built around the drive,
-//!   HDL-64E scans produced on demand while the local maps are built) and streamed through
-//!   [`SweepSequence::from_fn`]; nothing is written to disk. `POLES_KITTI_SEQUENCES=00,07`
-//!   restricts the run to the listed sequences (`none`: the real section alone).
+//!   is simulated in memory
+//!   ([`SemiKittiDrive`](raypath_sim::semi_kitti::SemiKittiDrive): the street world built
+//!   around the drive, HDL-64E scans produced on demand while the local maps are built) and
+//!   streamed through
+//!   [`SweepSequence::from_fn`](raypath_io::sequence::SweepSequence::from_fn); nothing is
+//!   written to disk. `POLES_KITTI_SEQUENCES=00,07` restricts the run to the listed
+//!   sequences (`none`: the real section alone).
 //! * Same-drive protocol (as the thesis, `kittipoles.py`): local maps every 3 m over 5 m of
 //!   trajectory with the ground-truth poses, merged into the reference map; localization on
 //!   the same drive with 2000 particles, 3 m / ±5° initial spread, increments corrupted by
