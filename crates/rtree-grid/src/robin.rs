@@ -8,6 +8,12 @@
 //! a later home; deletion shifts the following entries back (no tombstones). A slot is
 //! 6 unaligned bytes (one memory access per probe), any slot count. Tables grow (double) at
 //! load ⅘ and are built at load 9/10 (compact, for a map at rest).
+//!
+//! Why not `hashbrown` (or `std`'s map with `rustc-hash`): a keyed map stores the key beside
+//! the value — at least 8 + 4 bytes plus a control byte per entry, padded to 16 — and cannot
+//! hold several cells under one block key. Here the key is recomputed from the cell (its box
+//! or lattice key), so an entry is 6 bytes; the index is part of the map size the
+//! `octomap` evaluation compares with OctoMap's `memoryUsage()`.
 
 /// One slot: a cell id and `tag | displacement << TAG_BITS` (all displacement bits set:
 /// empty).
