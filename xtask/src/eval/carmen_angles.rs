@@ -23,7 +23,7 @@ use rayon::prelude::*;
 use raypath_io::carmen::{CarmenReader, FanConvention, Record};
 use serde_json::json;
 
-use super::stages::{self, Staged};
+use super::stages::Staged;
 use super::{EvalContext, EvalReport};
 use crate::render::TopDown;
 use crate::table::{Table, fmt_num};
@@ -238,11 +238,6 @@ pub const STAGED: Staged = Staged {
     run_unit,
     report: report_units,
 };
-
-/// Runs the evaluation (every log, then the report).
-pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
-    stages::run_all(&STAGED, ctx)
-}
 
 fn log_dir(ctx: &EvalContext) -> PathBuf {
     ctx.data("carmen/corrected")

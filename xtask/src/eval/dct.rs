@@ -109,11 +109,6 @@ pub const STAGED: Staged = Staged {
     report,
 };
 
-/// Runs the evaluation (every log, then the report).
-pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
-    stages::run_all(&STAGED, ctx)
-}
-
 const TITLE: &str = "Continuous DCT decay-rate maps against grid maps (Tables 9.2-9.4)";
 /// The corrected logs' file names end so.
 const SUFFIX: &str = "-corrected.log.gz";

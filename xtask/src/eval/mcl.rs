@@ -139,11 +139,6 @@ pub const STAGED: Staged = Staged {
     report,
 };
 
-/// Runs the evaluation (every data set, then the report).
-pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
-    stages::run_all(&STAGED, ctx)
-}
-
 /// The 2-D data sets in report order: the real logs, then the simulated indoor worlds.
 fn planar_units(ctx: &EvalContext) -> Vec<String> {
     let worlds = ["office", "hall", "lab"].into_iter();

@@ -129,124 +129,132 @@ pub struct EvalReport {
     pub headline: Option<String>,
 }
 
-type EvalFn = fn(&EvalContext) -> Result<EvalReport>;
+/// How an evaluation runs: one function, or in stages (then `--shard` and `merge` work).
+enum Runner {
+    /// The whole evaluation in one call.
+    Whole(fn(&EvalContext) -> Result<EvalReport>),
+    /// Units, then the report ([`stages::run_all`]).
+    Staged(&'static stages::Staged),
+}
+
+impl Runner {
+    fn run(&self, ctx: &EvalContext) -> Result<EvalReport> {
+        match self {
+            Runner::Whole(run) => run(ctx),
+            Runner::Staged(staged) => stages::run_all(staged, ctx),
+        }
+    }
+}
 
 /// All evaluations in the order `all` runs them.
-const EVALUATIONS: &[(&str, &str, EvalFn)] = &[
+const EVALUATIONS: &[(&str, &str, Runner)] = &[
     (
         "io",
         "read every file under RAYPATH_DATA: counts and throughput per format",
-        io::run,
+        Runner::Whole(io::run),
     ),
     (
         "geometry",
         "exact ray traversal throughput in 2-D and 3-D (cells per second)",
-        geometry::run,
+        Runner::Whole(geometry::run),
     ),
     (
         "sim",
         "simulated data sets: contents, statistics beside real samples, pictures",
-        sim::run,
+        Runner::Whole(sim::run),
     ),
     (
         "carmen-angles",
         "CARMEN beam-angle convention checked by map sharpness on the corrected logs",
-        carmen_angles::run,
+        Runner::Staged(&carmen_angles::STAGED),
     ),
     (
         "sensor-models",
         "sensor models scored at the true pose and by inverse KL (Schaefer Tables 7.3, 8.2, 8.3)",
-        sensor_models::run,
+        Runner::Whole(sensor_models::run),
     ),
     (
         "mcl",
         "Monte-Carlo localization error per sensor model (Table 7.2), ch. 8 corridor, filter speed",
-        mcl::run,
+        Runner::Staged(&mcl::STAGED),
     ),
     (
         "polylines",
         "PLE, PLE+ and the VVL/IEF/SAM baselines on real and simulated scans (Fig. 10.4, Table 10.2)",
-        polylines::run,
+        Runner::Staged(&polylines::STAGED),
     ),
     (
         "synpeb",
         "PPE plane extraction on SynPEB-style scans at five noise levels (Table 11.1)",
-        synpeb::run,
+        Runner::Staged(&synpeb::STAGED),
     ),
     (
         "segcomp",
         "PPE, PEAC-style and MSAC grid-searched on SegComp Perceptron (when installed) and a simulated stand-in (Table 11.1)",
-        segcomp::run,
+        Runner::Whole(segcomp::run),
     ),
     (
         "octomap",
         "Rtree variable-resolution occupancy grid beside OctoMap measured in the same run (Khan ch. 2)",
-        octomap::run,
+        Runner::Staged(&octomap::STAGED),
     ),
     (
         "memory",
         "peak resident memory of the Rtree grid (beside OctoMap), pole extraction and PPE",
-        memory::run,
+        Runner::Whole(memory::run),
     ),
     (
         "poles-kitti",
         "pole extraction and pole-based localization on semi-synthetic KITTI drives (Table 12.2)",
-        poles_kitti::run,
+        Runner::Staged(&poles_kitti::STAGED),
     ),
     (
         "poles-nclt",
         "pole-based localization over simulated NCLT-style sessions (Table 12.1)",
-        poles_nclt::run,
+        Runner::Staged(&poles_nclt::STAGED),
     ),
     (
         "dct",
         "continuous DCT decay-rate maps against grid maps on the real logs (Tables 9.2-9.4)",
-        dct::run,
+        Runner::Staged(&dct::STAGED),
     ),
     (
         "scan-matching",
         "intensity calibration and Hector-style scan matching with occupancy/reflectivity residuals (Khan ch. 3)",
-        scan_matching::run,
+        Runner::Whole(scan_matching::run),
     ),
     (
         "slam",
         "2-D SLAM (submaps, branch-and-bound loop closure, robust pose graph) on the SLAM-benchmark logs",
-        slam::run,
+        Runner::Staged(&slam::STAGED),
     ),
     (
         "place-recognition",
         "IBuILD loop closure and lidar place recognition beside DBoW2, Scan Context, HOG, GIST, SHOT (Khan ch. 4)",
-        place_recognition::run,
+        Runner::Whole(place_recognition::run),
     ),
     (
         "registration",
         "3-D point-to-plane ICP and KISS-ICP-style odometry on the real KITTI and Ouster frames",
-        registration::run,
+        Runner::Staged(&registration::STAGED),
     ),
 ];
 
-/// Runs `name` (or `all`, or `list`).
 /// The evaluations written in stages: `--shard i/n` and `eval merge` work for these.
-const STAGED: &[&stages::Staged] = &[
-    &carmen_angles::STAGED,
-    &registration::STAGED,
-    &octomap::STAGED,
-    &polylines::STAGED,
-    &dct::STAGED,
-    &mcl::STAGED,
-    &poles_kitti::STAGED,
-    &poles_nclt::STAGED,
-    &slam::STAGED,
-    &synpeb::STAGED,
-];
+fn staged_evaluations() -> impl Iterator<Item = &'static stages::Staged> {
+    EVALUATIONS
+        .iter()
+        .filter_map(|(_, _, runner)| match runner {
+            Runner::Staged(staged) => Some(*staged),
+            Runner::Whole(_) => None,
+        })
+}
 
 fn staged(name: &str) -> Result<&'static stages::Staged> {
-    STAGED
-        .iter()
-        .copied()
+    staged_evaluations()
         .find(|s| s.name == name)
         .with_context(|| {
-            let names: Vec<_> = STAGED.iter().map(|s| s.name).collect();
+            let names: Vec<_> = staged_evaluations().map(|s| s.name).collect();
             format!(
                 "{name:?} is not (yet) written in stages; --shard and merge work for: {}",
                 names.join(", ")
@@ -286,6 +294,7 @@ pub fn merge(name: &str, quick: bool) -> Result<()> {
     write_report(&ctx, &report, seconds)
 }
 
+/// Runs `name` (or `all`, or `list`).
 pub fn run(name: &str, quick: bool) -> Result<()> {
     if name == "list" {
         for (name, about, _) in EVALUATIONS {
@@ -308,10 +317,10 @@ pub fn run(name: &str, quick: bool) -> Result<()> {
         found
     };
     let mut failures = Vec::new();
-    for (name, _, eval) in selected {
+    for (name, _, runner) in selected {
         eprintln!("== eval {name}{}", if quick { " (quick)" } else { "" });
         let started = Instant::now();
-        match eval(&ctx) {
+        match runner.run(&ctx) {
             Ok(report) => write_report(&ctx, &report, started.elapsed().as_secs_f64())?,
             Err(error) => {
                 eprintln!("eval {name} failed: {error:#}");

@@ -61,11 +61,6 @@ pub const STAGED: Staged = Staged {
     report,
 };
 
-/// Runs the evaluation (every data set, then the report).
-pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
-    stages::run_all(&STAGED, ctx)
-}
-
 /// The KITTI sequences of the run.
 fn kitti(ctx: &EvalContext) -> &'static [&'static str] {
     if ctx.quick {

@@ -139,11 +139,6 @@ pub const STAGED: Staged = Staged {
     report,
 };
 
-/// Runs the evaluation (every unit, then the report).
-pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
-    stages::run_all(&STAGED, ctx)
-}
-
 /// The real section, then the planned sequences (`POLES_KITTI_SEQUENCES` may select).
 fn units(ctx: &EvalContext) -> Result<Vec<String>> {
     let mut units = vec![REAL_UNIT.to_owned()];

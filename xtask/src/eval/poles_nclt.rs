@@ -46,7 +46,7 @@ use serde_json::{Value, json};
 
 use self::protocol::PoleMap;
 use super::poles_kitti::truth_near;
-use super::stages::{self, Staged, UnitResults};
+use super::stages::{Staged, UnitResults};
 use super::{EvalContext, EvalReport};
 
 const NAME: &str = "poles-nclt";
@@ -78,11 +78,6 @@ pub const STAGED: Staged = Staged {
     run_unit,
     report,
 };
-
-/// Runs the evaluation (every unit, then the report).
-pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
-    stages::run_all(&STAGED, ctx)
-}
 
 /// Localization runs per session: 10 as the thesis, 2 in `--quick`.
 fn runs(quick: bool) -> usize {

@@ -100,11 +100,6 @@ pub const STAGED: Staged = Staged {
     report,
 };
 
-/// Runs the evaluation (every log and block of simulated scans, then the report).
-pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
-    stages::run_all(&STAGED, ctx)
-}
-
 /// Real scans per log and simulated scans in all.
 fn counts(ctx: &EvalContext) -> (usize, usize) {
     if ctx.quick { (3, 40) } else { (20, 260) }

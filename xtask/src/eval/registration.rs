@@ -25,7 +25,7 @@ use raypath_io::sequence::{SweepOptions, SweepSequence};
 use raypath_registration::{Odometry, OdometryConfig, RegistrationConfig, register};
 use serde_json::{Value, json};
 
-use super::stages::{self, Staged, UnitResults};
+use super::stages::{Staged, UnitResults};
 use super::{EvalContext, EvalReport, comparable, median};
 use crate::table::{Table, fmt_num};
 
@@ -317,11 +317,6 @@ pub const STAGED: Staged = Staged {
     report,
 };
 
-/// Runs the evaluation (every sequence, then the report).
-pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
-    stages::run_all(&STAGED, ctx)
-}
-
 const OUSTER_UNIT: &str = "ouster";
 
 fn units(_: &EvalContext) -> Result<Vec<String>> {
@@ -543,7 +538,7 @@ mod tests {
             quick: true,
             out_dir: crate::eval::workspace_root(),
         };
-        let report = run(&ctx).unwrap();
+        let report = crate::eval::stages::run_all(&STAGED, &ctx).unwrap();
         assert!(report.markdown.contains("| published (KISS-ICP)"));
         assert!(report.markdown.contains(&format!("absent: {OUSTER}")));
         assert!(report.headline.is_none());

@@ -24,7 +24,7 @@ use raypath_slam::graph::RobustKernel;
 use raypath_slam::{Slam, SlamConfig, SlamOutput};
 use serde_json::{Value, json};
 
-use super::stages::{self, Staged, UnitResults};
+use super::stages::{Staged, UnitResults};
 use super::{EvalContext, EvalReport};
 
 const NAME: &str = "slam";
@@ -214,11 +214,6 @@ pub const STAGED: Staged = Staged {
     run_unit,
     report,
 };
-
-/// Runs the evaluation (every unit, then the report).
-pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
-    stages::run_all(&STAGED, ctx)
-}
 
 /// The simulated worlds of the residual ablation.
 fn worlds(quick: bool) -> &'static [&'static str] {

@@ -23,7 +23,7 @@ use raypath_io::pcd::{ReadOptions, read_pcd};
 use raypath_planes::{MsacParams, PeacParams, PpeParams};
 
 use super::planes::{HooverScore as Scan, Method, hoover_score, mean};
-use super::stages::{self, Staged, UnitResults, field};
+use super::stages::{Staged, UnitResults, field};
 use super::{EvalContext, EvalReport, median};
 use crate::table::{Table, fmt_num};
 
@@ -118,11 +118,6 @@ pub const STAGED: Staged = Staged {
     run_unit,
     report,
 };
-
-/// Runs the evaluation (every unit, then the report).
-pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
-    stages::run_all(&STAGED, ctx)
-}
 
 /// The noise levels of the generated split, the real sample, the real scans.
 fn units(_ctx: &EvalContext) -> Result<Vec<String>> {
