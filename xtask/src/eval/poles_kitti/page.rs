@@ -303,8 +303,8 @@ fn sections(md: &mut String, tables: &Tables) -> Result<()> {
          ≈ 0.5 M points/s with a GPU, the aim is ≥ 5 M points/s on 2 cores. Update rate = \
          measurement updates (association + weights + resampling) per second of the \
          same-drive runs. `total` = the whole sequence (world, scans, maps, all runs). \
-         Measured on a shared 2-core machine while other jobs ran: absolute times are \
-         pessimistic.\n\n{}",
+         Measured on a 2-core machine that other jobs may share: compare figures within one \
+         run.\n\n{}",
         tables.speed.to_markdown()?
     )?;
     Ok(())
