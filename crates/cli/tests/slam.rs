@@ -14,6 +14,8 @@ fn intel_json_contract_outputs_and_errors() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
+    let relations = dir.path().join("intel-derived.relations");
+    write_derived_relations(&raw, &corrected, 2500, &relations);
     let out = raypath(&[
         "slam",
         raw.to_str().unwrap(),
@@ -23,6 +25,8 @@ fn intel_json_contract_outputs_and_errors() {
         "2500",
         "--ground-truth",
         corrected.to_str().unwrap(),
+        "--relations",
+        relations.to_str().unwrap(),
         "--json",
     ]);
     let doc = json_of(&out);
@@ -48,6 +52,18 @@ fn intel_json_contract_outputs_and_errors() {
     // Better than odometry (≈ 0.05 m per relation on this stretch) and no wrong loop closure.
     assert!(s["trans_error_m"].as_f64().unwrap() < 0.045, "{s}");
     assert_eq!(doc["wrong_loop_closures"], 0, "{doc}");
+    // The same consecutive relations as a benchmark relation file (scans named by ipc time
+    // stamps, six decimals) give the same figures.
+    let f = &doc["relations_file"];
+    assert_eq!(f["unmatched"], 0, "{f}");
+    assert_eq!(f["summary"]["relations"], s["relations"], "{f}");
+    for key in ["trans_error_m", "rot_error_deg"] {
+        let (a, b) = (
+            f["summary"][key].as_f64().unwrap(),
+            s[key].as_f64().unwrap(),
+        );
+        assert!((a - b).abs() < 1e-6, "{key}: {a} vs {b}");
+    }
     // TUM: one line per scan, 8 numbers, z = 0.
     let tum = std::fs::read_to_string(dir.path().join("trajectory.txt")).unwrap();
     let lines: Vec<&str> = tum.lines().filter(|l| !l.starts_with('#')).collect();
@@ -75,6 +91,28 @@ fn intel_json_contract_outputs_and_errors() {
         "--json",
     ]));
     assert_eq!(info["scans"], 2500, "{info}");
+}
+
+/// Consecutive relations between the first `scans` raw scans that pair with the corrected log,
+/// written in the SLAM benchmark's relation format.
+fn write_derived_relations(
+    raw: &std::path::Path,
+    corrected: &std::path::Path,
+    scans: usize,
+    path: &std::path::Path,
+) {
+    use raypath_io::sequence::{PlanarOptions, pair_reference, read_planar};
+    use raypath_slam::benchmark::{consecutive_relations, relations_from_reference};
+    let options = PlanarOptions::default();
+    let mut frames = read_planar(raw, &options).unwrap();
+    frames.truncate(scans);
+    pair_reference(&mut frames, &read_planar(corrected, &options).unwrap());
+    let truth: Vec<_> = frames.iter().map(|f| f.reference).collect();
+    let stamps: Vec<_> = frames.iter().map(|f| f.ipc_stamp_secs).collect();
+    let referenced: Vec<usize> = (0..frames.len()).filter(|&i| truth[i].is_some()).collect();
+    let relations = relations_from_reference(&stamps, &truth, &consecutive_relations(&referenced));
+    assert!(relations.len() > 10);
+    raypath_io::relations::write_relations(path, &relations).unwrap();
 }
 
 #[test]

@@ -267,7 +267,7 @@ pub fn write_carmen(path: &Path, frames: &[PlanarFrame]) -> Result<PathBuf> {
             world_from_robot: frame.world_from_robot,
             velocities: None,
             robot_laser: None,
-            ipc_timestamp_secs: frame.stamp_secs,
+            ipc_timestamp_secs: frame.ipc_stamp_secs.unwrap_or(frame.stamp_secs),
             hostname: "raypath".into(),
             logger_timestamp_secs: frame.stamp_secs,
             line: 0,

@@ -68,6 +68,7 @@ pub mod ouster;
 pub mod pcd;
 pub mod point_csv;
 pub mod poles_csv;
+pub mod relations;
 pub mod rosbag;
 pub mod samples;
 pub mod segcomp;

@@ -61,6 +61,7 @@ fn synthetic_frames(n: usize, moving_mount: bool, reference: bool) -> Vec<Planar
                 .collect();
             PlanarFrame {
                 stamp_secs: t,
+                ipc_stamp_secs: None,
                 scan: Scan2 {
                     angle_min_rad: -std::f64::consts::FRAC_PI_2,
                     angle_increment_rad: std::f64::consts::PI / 36.0,

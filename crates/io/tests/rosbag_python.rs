@@ -138,6 +138,7 @@ fn frames(n: usize) -> Vec<PlanarFrame> {
             let mount = Pose2::new(0.25, 0.0, 0.0);
             PlanarFrame {
                 stamp_secs: 1_700_000_000.5 + k as f64 * 0.1,
+                ipc_stamp_secs: None,
                 scan: Scan2 {
                     angle_min_rad: -1.5,
                     angle_increment_rad: 0.01,

@@ -40,7 +40,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         config.loops = None;
     }
     // Quick knobs for experiments: SLAM_RES, SLAM_SEQ (σ_t of sequential edges), SLAM_LOOP
-    // (σ_t of loop edges), SLAM_EVERY (loop search every n nodes), SLAM_NODES (per submap).
+    // (σ_t of loop edges), SLAM_EVERY (loop search every n nodes), SLAM_NODES (per submap),
+    // SLAM_ITER (finest-level iterations), SLAM_LEVELS, SLAM_FREE / SLAM_OCC (update factors),
+    // SLAM_NODE_DIST (node spacing), SLAM_RANGE (max range); SLAM_WRITE_RELATIONS=FILE writes
+    // the consecutive reference relations as a benchmark relation file.
     let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
     if let Some(r) = env("SLAM_RES") {
         config.matcher.map.finest_resolution_m = r;
@@ -71,6 +74,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     if let Some(n) = env("SLAM_NODES") {
         config.submaps.nodes_per_submap = n as usize;
+    }
+    if let Some(n) = env("SLAM_ITER") {
+        config.matcher.iterations_finest = n as usize;
+    }
+    if let Some(n) = env("SLAM_LEVELS") {
+        config.matcher.map.levels = n as usize;
+    }
+    if let Some(f) = env("SLAM_FREE") {
+        config.matcher.map.update_factor_free = f;
+    }
+    if let Some(f) = env("SLAM_OCC") {
+        config.matcher.map.update_factor_occupied = f;
+    }
+    if let Some(d) = env("SLAM_NODE_DIST") {
+        config.submaps.node_distance_m = d;
+    }
+    if let Some(r) = env("SLAM_RANGE") {
+        config.filter.max_range_m = r;
     }
     let t0 = Instant::now();
     let mut slam = Slam::new(config)?;
@@ -113,6 +134,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let referenced: Vec<usize> = (0..frames.len())
         .filter(|&i| reference[i].is_some())
         .collect();
+    if let (Ok(path), false) = (std::env::var("SLAM_WRITE_RELATIONS"), referenced.is_empty()) {
+        // The consecutive relations in the SLAM benchmark's file format.
+        let stamps: Vec<_> = frames.iter().map(|f| f.ipc_stamp_secs).collect();
+        let relations = raypath_slam::benchmark::relations_from_reference(
+            &stamps,
+            &reference,
+            &consecutive_relations(&referenced),
+        );
+        raypath_io::relations::write_relations(std::path::Path::new(&path), &relations)?;
+    }
     if !referenced.is_empty() {
         let c = relation_errors(
             &reference,
@@ -127,6 +158,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let odo: Vec<_> = frames.iter().map(|f| f.world_from_laser).collect();
         let o = relation_errors(&reference, &odo, &consecutive_relations(&referenced));
         println!("consecutive: {c:?}\nrandom: {r:?}\nodometry consecutive: {o:?}");
+        {
+            let (mut t, _) = raypath_reflectivity::benchmark::relation_error_lists(
+                |i| reference.get(i).and_then(Option::as_ref),
+                &out.world_from_sensor,
+                &consecutive_relations(&referenced),
+            );
+            t.sort_by(f64::total_cmp);
+            let q = |p: f64| t[((t.len() - 1) as f64 * p).round() as usize];
+            println!(
+                "consecutive translation quantiles: 10 % {:.4}, 25 % {:.4}, 50 % {:.4}, 75 % {:.4}, 90 % {:.4}, 99 % {:.4}",
+                q(0.1),
+                q(0.25),
+                q(0.5),
+                q(0.75),
+                q(0.9),
+                q(0.99)
+            );
+        }
         if std::env::var("SLAM_WORST").is_ok() {
             for (i, j) in consecutive_relations(&referenced) {
                 let (gi, gj) = (

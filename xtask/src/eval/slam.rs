@@ -2,6 +2,9 @@
 //! relation errors of Kümmerle et al. (2009) against the corrected logs, beside odometry, the
 //! Hector front-end alone and the published figures of Cartographer, graph mapping and
 //! GMapping; large loops without reference are shown as maps with a self-consistency measure.
+//! Where the data directory holds the benchmark's own relation files
+//! (`carmen/relations/<log>.relations`), every row is also scored against them, like for like
+//! with the published figures.
 //!
 //! In stages (`--shard i/n`, `merge`): one unit per referenced log (`referenced/<log>`), per
 //! log without reference (`unreferenced/<log>`) and per simulated world of the residual
@@ -13,12 +16,13 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use raypath_geometry::Pose2;
+use raypath_io::relations::read_relations;
 use raypath_io::sequence::{PlanarFrame, PlanarOptions, pair_reference, read_planar};
 use raypath_reflectivity::benchmark::run_matcher;
 use raypath_reflectivity::{PointFilter, ResidualMode};
 use raypath_slam::benchmark::{
-    ErrorSummary, check_loops, consecutive_relations, random_relations, relation_errors,
-    scan_supported, submap_disagreement,
+    ErrorSummary, MatchedRelations, check_loops, consecutive_relations, file_relation_errors,
+    match_relation_file, random_relations, relation_errors, scan_supported, submap_disagreement,
 };
 use raypath_slam::graph::RobustKernel;
 use raypath_slam::{Slam, SlamConfig, SlamOutput};
@@ -92,6 +96,8 @@ struct Scored {
     checked: usize,
     seconds: f64,
     scans: usize,
+    /// Over the benchmark's own relation file, when the data set has it.
+    benchmark: Option<ErrorSummary>,
 }
 
 fn read(ctx: &EvalContext, path: &str, limit: Option<usize>) -> Result<Vec<PlanarFrame>> {
@@ -121,6 +127,8 @@ struct Relations {
     consecutive: Vec<(usize, usize)>,
     supported: Vec<(usize, usize)>,
     random: Vec<(usize, usize)>,
+    /// The benchmark's relation file (`carmen/relations/<log>.relations`), when present.
+    file: Option<MatchedRelations>,
 }
 
 impl Relations {
@@ -136,8 +144,30 @@ impl Relations {
             consecutive,
             supported,
             random,
+            file: None,
         }
     }
+}
+
+/// Where the benchmark's relation file of `log` is looked for under the data directory.
+fn relation_file(log: &str) -> String {
+    format!("carmen/relations/{log}.relations")
+}
+
+/// The benchmark's relation file of `log` matched to the frames' ipc time stamps, when the
+/// data set has it.
+fn read_relation_file(
+    ctx: &EvalContext,
+    log: &str,
+    frames: &[PlanarFrame],
+) -> Result<Option<MatchedRelations>> {
+    let path = ctx.data(&relation_file(log));
+    if !path.exists() {
+        return Ok(None);
+    }
+    let relations = read_relations(&path)?;
+    let stamps: Vec<_> = frames.iter().map(|f| f.ipc_stamp_secs).collect();
+    Ok(Some(match_relation_file(&stamps, &relations)))
 }
 
 fn score(
@@ -151,6 +181,7 @@ fn score(
     let consecutive = relation_errors(truth, poses, &rel.consecutive);
     let supported = relation_errors(truth, poses, &rel.supported);
     let random = relation_errors(truth, poses, &rel.random);
+    let benchmark = rel.file.as_ref().map(|m| file_relation_errors(poses, m));
     let (mut wrong, mut checked, mut loops, mut rejected, mut disputed) = (0, 0, 0, 0, 0);
     if let Some(out) = out {
         loops = out.loop_closures.len();
@@ -171,6 +202,7 @@ fn score(
         checked,
         seconds,
         scans: poses.len(),
+        benchmark,
     }
 }
 
@@ -187,6 +219,7 @@ fn row_json(log: &str, method: &str, s: &Scored) -> Value {
         "loop_closures": s.loops, "rejected_loop_closures": s.rejected,
         "wrong_loop_closures": s.wrong, "loop_closures_checked": s.checked,
         "wrong_loop_closures_reference_disputed": s.disputed,
+        "benchmark_relations": s.benchmark,
         "seconds": s.seconds, "scans": s.scans, "scans_per_second": sps,
     })
 }
@@ -277,7 +310,9 @@ fn referenced(ctx: &EvalContext, name: &str, raw: &str, corrected: &str) -> Resu
     let mut frames = read(ctx, raw, limit)?;
     let reference = read(ctx, corrected, None)?;
     pair_reference(&mut frames, &reference);
-    let relations = Relations::of(&frames);
+    let mut relations = Relations::of(&frames);
+    relations.file = read_relation_file(ctx, name, &frames)?;
+    let unmatched = relations.file.as_ref().map(|m| m.unmatched);
     let odometry: Vec<Pose2> = frames.iter().map(|f| f.world_from_laser).collect();
     let mut rows = vec![row_json(
         name,
@@ -313,7 +348,7 @@ fn referenced(ctx: &EvalContext, name: &str, raw: &str, corrected: &str) -> Resu
         );
         rows.push(row_json(name, label, &s));
     }
-    Ok(json!({ "rows": rows }))
+    Ok(json!({ "rows": rows, "relation_file_unmatched": unmatched }))
 }
 
 /// A log without reference: SLAM with and without loop closure, the submap disagreement of

@@ -27,7 +27,7 @@
 //!
 //! Cases are independent: case `n` of reader `r` draws from a generator seeded with
 //! `(seed, r, n)`, so the same seed gives the same inputs on any number of threads. Cases run
-//! on all cores (rayon). The default run (10⁵ cases for each of the 27 readers) takes about a
+//! on all cores (rayon). The default run (10⁵ cases for each of the 28 readers) takes about a
 //! minute on 2 cores, half of it the rosbag reader, whose every open starts worker threads:
 //! its seeds are three small bags (two messages per topic) and each case uses one of its three
 //! entry points.

@@ -15,7 +15,7 @@ use raypath_io::point_csv::{PointCsv, PointCsvReader};
 use raypath_io::sequence::{SweepSequence, Topics};
 use raypath_io::xyz::XyzReader;
 use raypath_io::{
-    Error, Location, kitti, lzw, nclt, octomap, pcd, poles_csv, rosbag, segcomp, tum,
+    Error, Location, kitti, lzw, nclt, octomap, pcd, poles_csv, relations, rosbag, segcomp, tum,
 };
 
 use raypath_io::samples::{self, Sample};
@@ -720,6 +720,17 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
                 check.verdict()
             },
         ),
+        Target::new(
+            "relations",
+            "relations::parse_relations",
+            samples::relations(),
+            &[],
+            |input| {
+                let mut check = Check::new(input, input.name, true);
+                check.ok(relations::parse_relations(cursor(input), input.name));
+                check.verdict()
+            },
+        ),
         Target::new("tum", "tum::parse_tum", samples::tum(), &[], |input| {
             let mut check = Check::new(input, input.name, true);
             check.ok(tum::parse_tum(cursor(input), input.name));
@@ -775,7 +786,7 @@ pub fn all(scratch: &Path) -> Result<Vec<Target>> {
 }
 
 /// Table order: by crate module.
-const ORDER: [&str; 27] = [
+const ORDER: [&str; 28] = [
     "carmen",
     "kitti-velodyne",
     "kitti-labels",
@@ -800,6 +811,7 @@ const ORDER: [&str; 27] = [
     "lzw",
     "point-csv",
     "poles-csv",
+    "relations",
     "tum",
     "xyz",
     "summarize",

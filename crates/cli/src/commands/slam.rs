@@ -3,7 +3,8 @@
 //! sparse pose graph.
 //!
 //! ```text
-//! raypath slam <log-or-bag> --out DIR [--resolution R] [--ground-truth CORRECTED] [--json]
+//! raypath slam <log-or-bag> --out DIR [--resolution R] [--ground-truth CORRECTED]
+//!              [--relations FILE.relations] [--json]
 //!              [--model decay-rate|reflection|log-odds] [--no-loops] [--no-odometry]
 //!              [--mode occupancy|reflectivity|combined --lut FILE] [--max-range M] [--scans N]
 //!              [--laser …] [--scan-topic T] [--odom-topic T] [--record OUT.mcap]
@@ -25,6 +26,10 @@
 //! whose association error is above 0.3 m or 3°, `raypath_slam::benchmark::check_loops`, of
 //! `"loop_closures_checked"`; `"wrong_loop_closures_reference_disputed"` counts those of
 //! them where the corrected log disagrees with its own scans, `LoopCheck::reference_disputed`).
+//! With `--relations` (the SLAM benchmark's own relation file of the log, e.g.
+//! `intel.relations`, whose scans are named by the CARMEN ipc time stamps), `"relations_file":
+//! {"path", "summary", "unmatched"}` scores the trajectory by the benchmark's protocol: the
+//! figure the published results (Cartographer, graph mapping, GMapping) are given in.
 //!
 //! `--record OUT.mcap`: every scan at its optimised pose (`/tf`, `/scan`), the `/trajectory`,
 //! the rebuilt map as `/map` and the loop closures as lines (`/loops`).
@@ -34,11 +39,13 @@ use std::time::Instant;
 
 use nalgebra::Point3;
 use raypath_io::foxglove::{frame, topic};
+use raypath_io::relations::read_relations;
 use raypath_io::sequence::{PlanarFrame, pair_reference};
 use raypath_reflectivity::ResidualMode;
 use raypath_sensor_models::export::{MapFile, StoredStats};
 use raypath_slam::benchmark::{
-    check_loops, consecutive_relations, random_relations, relation_errors,
+    check_loops, consecutive_relations, file_relation_errors, match_relation_file,
+    random_relations, relation_errors,
 };
 use raypath_slam::{Slam, SlamConfig, SlamOutput};
 use serde_json::{Value, json};
@@ -64,6 +71,10 @@ pub struct Args {
     /// errors of Kümmerle et al. (2009) against it.
     #[arg(long, value_name = "LOG")]
     pub ground_truth: Option<PathBuf>,
+    /// The SLAM benchmark's relation file of this log (`t1 t2 x y z roll pitch yaw`, scans
+    /// named by their CARMEN ipc time stamps): report the relation errors over it.
+    #[arg(long, value_name = "FILE")]
+    pub relations: Option<PathBuf>,
     /// The sensor model of the rebuilt map.
     #[arg(long, value_enum, default_value = "reflection")]
     pub model: Model,
@@ -169,12 +180,18 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         Some(path) => Some(evaluate(args, path, &mut frames, &output)?),
         None => None,
     };
+    let relation_file = match &args.relations {
+        Some(path) => Some(score_relation_file(args, path, &frames, &output)?),
+        None => None,
+    };
     if let Some(recording) = &mut recording {
         record(recording, &frames, &output, &outputs.map_prefix, args.model)?;
     }
-    let doc = report(&output, seconds, &outputs, map, evaluation);
+    let mut doc = report(&output, seconds, &outputs, map, evaluation);
+    if let (Some(r), Some(obj)) = (relation_file, doc.as_object_mut()) {
+        obj.insert("relations_file".into(), r);
+    }
     if super::console::json() {
-        let mut doc = doc;
         super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
     } else {
@@ -291,6 +308,32 @@ fn evaluate(
     }))
 }
 
+/// Relation errors over the benchmark's relation file `path`, its scans found by ipc time stamp.
+fn score_relation_file(
+    args: &Args,
+    path: &Path,
+    frames: &[PlanarFrame],
+    out: &SlamOutput,
+) -> Result<Value, Failure> {
+    let relations = read_relations(path).map_err(Failure::input)?;
+    let stamps: Vec<_> = frames.iter().map(|f| f.ipc_stamp_secs).collect();
+    let matched = match_relation_file(&stamps, &relations);
+    if matched.relations.is_empty() {
+        return Err(Failure::input(format!(
+            "{}: none of its {} relations names two scans of {} by their ipc time stamps \
+             (relation files belong to CARMEN logs of the SLAM benchmark)",
+            path.display(),
+            relations.len(),
+            args.log.display()
+        )));
+    }
+    Ok(json!({
+        "path": path,
+        "summary": file_relation_errors(&out.world_from_sensor, &matched),
+        "unmatched": matched.unmatched,
+    }))
+}
+
 fn report(
     out: &SlamOutput,
     seconds: f64,
@@ -364,6 +407,18 @@ fn print(doc: &Value) {
             s.rot_error_std_deg,
             doc["wrong_loop_closures"],
             doc["loop_closures_checked"],
+        );
+    }
+    if let Ok(s) = serde_json::from_value::<SummaryView>(doc["relations_file"]["summary"].clone()) {
+        println!(
+            "relation error over {} relations of {}: {:.4} ± {:.4} m, {:.2} ± {:.2}° ({} not found in the log)",
+            s.relations,
+            doc["relations_file"]["path"].as_str().unwrap_or("?"),
+            s.trans_error_m,
+            s.trans_error_std_m,
+            s.rot_error_deg,
+            s.rot_error_std_deg,
+            doc["relations_file"]["unmatched"],
         );
     }
 }

@@ -230,6 +230,7 @@ impl BagScans {
             let world_from_robot = poses.world_from_robot.unwrap_or_else(Pose3::identity);
             return Ok(Some(PlanarFrame {
                 stamp_secs: t,
+                ipc_stamp_secs: None,
                 scan,
                 world_from_robot: world_from_robot.to_planar(),
                 world_from_laser: (world_from_robot * poses.robot_from_sensor).to_planar(),

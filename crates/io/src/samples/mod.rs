@@ -36,7 +36,7 @@ pub use pcap::{classic_pcap, ip_frames, pcapng, udp_datagram, udp_frames};
 pub use rosbag::{rosbag_bags, rosbag_cdr};
 pub use text::{
     CARMEN_LOG, carmen, kitti_calib, kitti_poses, kitti_times, nclt_covariance, nclt_pose_csv,
-    point_csv, poles_csv, rosbag_metadata, tum, xyz,
+    point_csv, poles_csv, relations, rosbag_metadata, tum, xyz,
 };
 
 /// One sample input and the file name it is read under.

@@ -1,5 +1,6 @@
 //! Text formats: CARMEN logs, KITTI poses, times and calibration, NCLT pose and covariance
-//! CSVs, point and pole CSVs, TUM trajectories, x y z files, rosbag2 metadata.
+//! CSVs, point and pole CSVs, TUM trajectories, SLAM-benchmark relation files, x y z files,
+//! rosbag2 metadata.
 
 use std::io::Cursor;
 use std::path::Path;
@@ -187,6 +188,16 @@ pub fn tum() -> Vec<Sample> {
         "trajectory.tum",
         "# t x y z qx qy qz qw\n1.0 0 0 0 0 0 0 1\n1.1 0.5 -0.25 0.1 0 0 0.0499792 0.9987503\n\
          1.2 1 -0.5 0.2 0.01 -0.02 0.0998334 0.9950042\n",
+    )]
+}
+
+/// A SLAM-benchmark relation file (`t1 t2 x y z roll pitch yaw`).
+pub fn relations() -> Vec<Sample> {
+    vec![Sample::new(
+        "intel.relations",
+        "# timestamp1 timestamp2 x y z roll pitch yaw\n\
+         976052857.337530 976052858.412270 0.412305 -0.010521 0.000000 0.000000 -0.000000 0.021807\n\
+         976052858.412270 976052861.093361 1.035640 0.046930 0.000000 0.000000 0.000000 -1.570796\n",
     )]
 }
 

@@ -61,6 +61,10 @@ impl fmt::Display for Origin {
 pub struct PlanarFrame {
     /// Time of the scan, seconds (the CARMEN logger timestamp; the header stamp in a bag).
     pub stamp_secs: f64,
+    /// The CARMEN ipc time stamp (when the message was sent), seconds: the SLAM benchmark's
+    /// relation files ([`crate::relations`]) name scans by it. `None` where the source has
+    /// none (bags).
+    pub ipc_stamp_secs: Option<f64>,
     /// The scan in the laser frame (REP-103; no-returns as ranges ≥ `max_range_m`).
     pub scan: Scan2,
     /// The robot's logged pose: odometry in raw logs and bags.
@@ -85,6 +89,7 @@ impl PlanarFrame {
     fn from_carmen(m: LaserMessage) -> Self {
         Self {
             stamp_secs: m.logger_timestamp_secs,
+            ipc_stamp_secs: Some(m.ipc_timestamp_secs),
             scan: m.scan,
             world_from_robot: m.world_from_robot,
             world_from_laser: m.world_from_laser,

@@ -198,8 +198,7 @@ pub(super) fn report(ctx: &EvalContext, results: &UnitResults) -> Result<EvalRep
     );
     let _ = writeln!(
         md,
-        "## Logs with a reference (real)\n\nRelations: the benchmark's relation files are not in \
-         the data set, so relations are derived from the corrected logs (raw scans paired with \
+        "## Logs with a reference (real)\n\nRelations: {} Relations are derived from the corrected logs (raw scans paired with \
          corrected scans by identical readings): **consecutive** referenced scans (local \
          accuracy) and {RANDOM_PAIRS} **random pairs** (seed {SEED}; global consistency). \
          Errors are Kümmerle et al. (2009)'s relative-pose errors, mean ± std. The corrected \
@@ -222,7 +221,8 @@ pub(super) fn report(ctx: &EvalContext, results: &UnitResults) -> Result<EvalRep
          referenced scans more than 30 scans away (`LoopCheck::reference_disputed`): there the \
          corrected log disagrees with itself, and the association error says nothing about the \
          loop. The count stays in the wrong column. fr-clinic has no corrected log in the data set; it is in the \
-         second table.\n"
+         second table.\n",
+        relation_file_note(&of_kind(results, "referenced/"))
     );
     let referenced = of_kind(results, "referenced/");
     notes(&mut md, &referenced);
@@ -274,10 +274,39 @@ pub(super) fn report(ctx: &EvalContext, results: &UnitResults) -> Result<EvalRep
     })
 }
 
+/// Whether the benchmark's relation files were found (`carmen/relations/<log>.relations`).
+fn relation_file_note(units: &[&Value]) -> String {
+    let found: Vec<String> = units
+        .iter()
+        .filter_map(|u| {
+            let unmatched = u["relation_file_unmatched"].as_u64()?;
+            let log = u["rows"][0]["log"].as_str()?;
+            Some(format!(
+                "{log} ({unmatched} of its relations name no scan of the log)"
+            ))
+        })
+        .collect();
+    if found.is_empty() {
+        "the benchmark's relation files (Kümmerle et al. 2009; `intel.relations` …) are not in \
+         the data set; put them under `carmen/relations/<log>.relations` in `RAYPATH_DATA` and \
+         the tables add a **benchmark relations** column, like for like with the published \
+         figures."
+            .into()
+    } else {
+        format!(
+            "the **benchmark relations** column scores against the benchmark's own relation \
+             files (Kümmerle et al. 2009; `carmen/relations/<log>.relations`, scans found by \
+             their ipc time stamps), found for {}.",
+            found.join(", ")
+        )
+    }
+}
+
 fn published(md: &mut String, rows: &[Value]) -> Result<()> {
     let mut t = Table::new([
         "log",
         "raypath-slam (ours)",
+        "ours, benchmark relations",
         "ours, scan-supported relations",
         "Cartographer (Hess 2016)",
         "graph mapping (Kümmerle 2009)",
@@ -297,9 +326,17 @@ fn published(md: &mut String, rows: &[Value]) -> Result<()> {
                 })
         };
         let (ours, supported) = (ours_of("summary"), ours_of("scan_supported"));
+        let benchmark = match ours_of("benchmark_relations") {
+            b if b.starts_with('—') => "— (no relation file)".to_owned(),
+            b => b,
+        };
+        let like = if benchmark.starts_with('—') || benchmark == "not run" {
+            "no: ours over consecutive corrected-log scans, theirs over the benchmark's relation files; other hardware"
+        } else {
+            "benchmark relations column: yes (same log, relation file and metric), other hardware; the other two columns: no"
+        };
         t.row([
-            log, &ours, &supported, carto, graph, gmapping,
-            "no: ours over consecutive corrected-log scans, theirs over the benchmark's relation files; other hardware",
+            log, &ours, &benchmark, &supported, carto, graph, gmapping, like,
         ]);
     }
     let _ = writeln!(md, "{}", t.to_markdown()?);
@@ -335,6 +372,7 @@ mod tests {
             checked: 11,
             seconds: 2.0,
             scans: 500,
+            benchmark: None,
         };
         let json = row_json("intel", "raypath-slam", &s);
         let md = scored("log", "method", std::slice::from_ref(&json)).unwrap();
@@ -362,6 +400,7 @@ mod tests {
         let fr079 = page.lines().find(|l| l.starts_with("| fr079")).unwrap();
         assert!(fr079.contains("not run"), "{fr079}");
         assert!(page.lines().filter(|l| l.contains("| no:")).count() == 3);
+        assert!(intel.contains("— (no relation file)"), "{intel}");
     }
 
     /// The page from one unit of each kind and a skipped one: every table has its row, the
@@ -379,8 +418,10 @@ mod tests {
             checked: 11,
             seconds: 2.0,
             scans: 500,
+            benchmark: Some(summary(0.025, 700)),
         };
-        let referenced = json!({ "rows": [row_json("intel", "raypath-slam", &s)] });
+        let referenced = json!({ "rows": [row_json("intel", "raypath-slam", &s)],
+                                 "relation_file_unmatched": 4 });
         let unreferenced = json!({
             "log": "malaga-telecom", "scans": 9000, "nodes": 2000, "submaps": 60,
             "loop_closures": 40, "rejected_loop_closures": 2,
@@ -412,6 +453,17 @@ mod tests {
         assert!(md.contains("* `indoor/lab` has no remissions"), "{md}");
         assert!(md.contains("| lab "), "{md}");
         assert_eq!(page.json["referenced"][0]["loop_closures"], 12);
+        // The relation file's column and note, like for like only there.
+        assert!(
+            md.contains("found for intel (4 of its relations name no scan"),
+            "{md}"
+        );
+        let intel = md
+            .lines()
+            .find(|l| l.starts_with("| intel ") && l.contains("0.0229 ± 0.0239"))
+            .expect("published row");
+        assert!(intel.contains("0.0250 ± 0.0125"), "{intel}");
+        assert!(intel.contains("benchmark relations column: yes"), "{intel}");
         assert!(page.json["unreferenced"][0].get("submaps").is_none());
         assert_eq!(page.json["residual_ablation"].as_array().unwrap().len(), 1);
     }

@@ -12,10 +12,22 @@
 //!   consistency, as in the benchmark's relations across loops).
 //!
 //! The relation set is written into every report so the numbers can be reproduced.
+//!
+//! Where the benchmark's relation files are at hand (`intel.relations` …, read by
+//! [`raypath_io::relations`]), [`match_relation_file`] finds their scans by the logs' ipc time
+//! stamps and [`file_relation_errors`] scores an estimate against them: the benchmark's own
+//! protocol, like for like with the published figures.
 
 use raypath_geometry::Pose2;
 use raypath_reflectivity::benchmark::{Stats, relation_error, relation_error_lists};
 use serde::{Deserialize, Serialize};
+
+mod relation_file;
+
+pub use relation_file::{
+    MatchedRelations, STAMP_TOLERANCE_SECS, file_relation_errors, match_relation_file,
+    relations_from_reference,
+};
 
 /// Mean and standard deviation of the relation errors: the JSON keys are a contract of
 /// `raypath slam --ground-truth`.
@@ -74,8 +86,14 @@ pub fn relation_errors(
         estimate,
         relations,
     );
-    let degrees = r.into_iter().map(|dr| dr.abs().to_degrees());
-    let (t, r) = (Stats::of(t), Stats::of(degrees));
+    summarize(t, r)
+}
+
+/// The summary of translational (m) and rotational (rad, signed) relation errors; NaN figures
+/// when there are none.
+fn summarize(translations: Vec<f64>, rotations_rad: Vec<f64>) -> ErrorSummary {
+    let degrees = rotations_rad.into_iter().map(|dr| dr.abs().to_degrees());
+    let (t, r) = (Stats::of(translations), Stats::of(degrees));
     let nan_if_empty = |v: f64| if t.count == 0 { f64::NAN } else { v };
     ErrorSummary {
         trans_error_m: nan_if_empty(t.mean),
