@@ -191,7 +191,7 @@ const EVALUATIONS: &[(&str, &str, Runner)] = &[
     (
         "segcomp",
         "PPE, PEAC-style and MSAC grid-searched on SegComp Perceptron (when installed) and a simulated stand-in (Table 11.1)",
-        Runner::Whole(segcomp::run),
+        Runner::Staged(&segcomp::STAGED),
     ),
     (
         "octomap",
@@ -221,7 +221,7 @@ const EVALUATIONS: &[(&str, &str, Runner)] = &[
     (
         "scan-matching",
         "intensity calibration and Hector-style scan matching with occupancy/reflectivity residuals (Khan ch. 3)",
-        Runner::Whole(scan_matching::run),
+        Runner::Staged(&scan_matching::STAGED),
     ),
     (
         "slam",

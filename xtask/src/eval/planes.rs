@@ -13,8 +13,8 @@ use raypath_planes::{
     HooverParams, MsacParams, PeacParams, PpeParams, Segmentation, compare, extract,
 };
 
-/// An extractor with its parameters.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// An extractor with its parameters (serde: the results of staged evaluations carry it).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Method {
     /// PPE, `raypath_planes::extract`.
     Ppe(PpeParams),

@@ -1,7 +1,8 @@
 //! Intensity calibration on real KITTI scans (Khan 2017 §3.3, Fig. 3.4 in real form): the LUT
 //! `I_ref(r, α)` fitted on the road class of SemanticKITTI as the reference surface, with
 //! angles of incidence from local PCA normals, and scored by the coefficient of variation of
-//! the corrected intensity per class on held-back frames.
+//! the corrected intensity per class on held-back frames. One unit: the LUT is fitted on the
+//! road samples of every sequence pooled.
 
 use std::fmt::Write;
 
@@ -12,10 +13,12 @@ use raypath_reflectivity::lut::CalibrationSample;
 use raypath_reflectivity::normals::incidence_angle;
 use raypath_reflectivity::{IntensityCorrection, IntensityLut, LutConfig, RangePolynomial};
 use raypath_registration::{RegistrationConfig, surface_normals};
+use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 
-use super::{coefficient_of_variation, overlap, quantile};
+use super::stats::{coefficient_of_variation, overlap, quantile};
 use crate::eval::EvalContext;
+use crate::eval::stages::float;
 use crate::table::{Table, fmt_num};
 
 /// The scored classes (SemanticKITTI ids): road is the reference surface.
@@ -120,14 +123,35 @@ fn frame_samples(
     out
 }
 
-/// Runs the section: writes its text and table into `md`, returns its JSON.
-pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
-    let sequences: &[&str] = if ctx.quick {
-        &["00"]
-    } else {
-        &["00", "01", "04", "07"]
-    };
-    let stride = if ctx.quick { 8 } else { 2 };
+/// The unit's result.
+#[derive(Debug, Serialize, Deserialize)]
+pub(super) struct KittiUnit {
+    /// The section's JSON as the page writes it (`{"skipped": …}` without labelled frames).
+    pub json: Value,
+    /// What the text says beyond the JSON; `None` when skipped.
+    pub fit: Option<FitFacts>,
+}
+
+/// The sampling and the fitted LUT's size.
+#[derive(Debug, Serialize, Deserialize)]
+pub(super) struct FitFacts {
+    /// Every `stride`-th labelled point was used.
+    pub stride: usize,
+    /// LUT rows (ranges) and columns (angles).
+    pub lut_ranges: usize,
+    pub lut_angles: usize,
+    /// Share of the LUT's entries inside the samples' hull, %.
+    #[serde(with = "float")]
+    pub inside_percent: f64,
+}
+
+/// The samples of every scored class of the labelled `sequences` (those without labels are
+/// left out) and the sequences used.
+fn collect(
+    ctx: &EvalContext,
+    sequences: &[&'static str],
+    stride: usize,
+) -> Result<(Vec<ClassSamples>, Vec<&'static str>)> {
     let mut classes: Vec<ClassSamples> = CLASSES.iter().map(|_| Default::default()).collect();
     let mut used = Vec::new();
     for seq in sequences {
@@ -156,13 +180,23 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
         }
         used.push(*seq);
     }
+    Ok((classes, used))
+}
+
+/// Fits the models on the road and scores them per class (the unit `kitti-calibration`).
+pub(super) fn measure(ctx: &EvalContext) -> Result<KittiUnit> {
+    let sequences: &[&str] = if ctx.quick {
+        &["00"]
+    } else {
+        &["00", "01", "04", "07"]
+    };
+    let stride = if ctx.quick { 8 } else { 2 };
+    let (classes, used) = collect(ctx, sequences, stride)?;
     if used.is_empty() {
-        let _ = writeln!(
-            md,
-            "*Skipped: no labelled real KITTI frames under `{}`.*\n",
-            ctx.data("kitti/sequences").display()
-        );
-        return Ok(json!({ "skipped": "no labelled KITTI frames" }));
+        return Ok(KittiUnit {
+            json: json!({ "skipped": "no labelled KITTI frames" }),
+            fit: None,
+        });
     }
     let road = &classes[0].fit;
     let step = road.len().div_ceil(MAX_FIT_SAMPLES).max(1);
@@ -182,13 +216,7 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
         IntensityCorrection::Range(poly),
         IntensityCorrection::Lut(lut.clone()),
     ];
-    let mut tables = Vec::new();
-    let mut rows = Vec::new();
-    for covered_only in [false, true] {
-        let (table, json_rows) = score(&models, &classes, &lut, covered_only);
-        tables.push(table);
-        rows.push(json_rows);
-    }
+    let rows = [false, true].map(|covered_only| score(&models, &classes, &lut, covered_only));
     let coverage: Vec<f64> = classes
         .iter()
         .map(|c| {
@@ -200,12 +228,57 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
             n as f64 / c.held.len().max(1) as f64
         })
         .collect();
-    let counts: Vec<String> = CLASSES
-        .iter()
-        .zip(&classes)
-        .map(|(c, s)| format!("{} {} / {}", c.1, s.fit.len(), s.held.len()))
-        .collect();
     let inside = lut.inside_hull.iter().filter(|&&b| b).count();
+    let [all, covered] = rows;
+    Ok(KittiUnit {
+        json: json!({
+            "coverage": coverage,
+            "models_covered_only": covered,
+            "sequences": used,
+            "reference_samples": raw_reference.len(),
+            "reference_bins": reference.len(),
+            "samples": CLASSES.iter().zip(&classes).map(|(c, s)| json!({
+                "class": c.0, "name": c.1, "fit": s.fit.len(), "held_back": s.held.len()
+            })).collect::<Vec<_>>(),
+            "models": all,
+        }),
+        fit: Some(FitFacts {
+            stride,
+            lut_ranges: lut.ranges,
+            lut_angles: lut.angles,
+            inside_percent: 100.0 * inside as f64 / lut.values.len().max(1) as f64,
+        }),
+    })
+}
+
+/// The section's text and tables.
+pub(super) fn markdown(ctx: &EvalContext, unit: &KittiUnit) -> Result<String> {
+    let mut md = String::new();
+    let Some(fit) = &unit.fit else {
+        let _ = writeln!(
+            md,
+            "*Skipped: no labelled real KITTI frames under `{}`.*\n",
+            ctx.data("kitti/sequences").display()
+        );
+        return Ok(md);
+    };
+    let json = &unit.json;
+    let used: Vec<&str> = json["sequences"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(Value::as_str)
+        .collect();
+    let counts: Vec<String> = json["samples"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .map(|s| {
+            let name = s["name"].as_str().unwrap_or_default();
+            format!("{name} {} / {}", s["fit"], s["held_back"])
+        })
+        .collect();
+    let stride = fit.stride;
     let _ = writeln!(
         md,
         "**Real data.** SemanticKITTI-labelled HDL-64E frames of sequences {} (every {stride}th \
@@ -221,13 +294,25 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
          surfaces); a lower CV per class and a lower overlap between classes is better.\n",
         used.join(", "),
         counts.join(", "),
-        raw_reference.len(),
-        reference.len(),
-        lut.ranges,
-        lut.angles,
-        100.0 * inside as f64 / lut.values.len().max(1) as f64,
+        json["reference_samples"],
+        json["reference_bins"],
+        fit.lut_ranges,
+        fit.lut_angles,
+        fit.inside_percent,
     );
-    let _ = writeln!(md, "All held-back points:\n\n{}", tables[0].to_markdown()?);
+    let rows = |key: &str| json[key].as_array().cloned().unwrap_or_default();
+    let (all, covered) = (rows("models"), rows("models_covered_only"));
+    let coverage: Vec<f64> = json["coverage"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .map(|v| v.as_f64().unwrap_or(f64::NAN))
+        .collect();
+    let _ = writeln!(
+        md,
+        "All held-back points:\n\n{}",
+        table(&all, false).to_markdown()?
+    );
     let _ = writeln!(
         md,
         "Only the held-back points inside the LUT's calibrated domain (the road samples' hull \
@@ -239,7 +324,7 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
             .map(|(c, v)| format!("{} {:.1} %", c.1, 100.0 * v))
             .collect::<Vec<_>>()
             .join(", "),
-        tables[1].to_markdown()?
+        table(&covered, true).to_markdown()?
     );
     let cv_of = |rows: &[Value], model: &str| -> Vec<f64> {
         rows.iter()
@@ -248,7 +333,7 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
             .map(|v| v.iter().filter_map(Value::as_f64).collect())
             .unwrap_or_default()
     };
-    let (raw_cv, lut_cv) = (cv_of(&rows[1], "raw"), cv_of(&rows[1], "lut"));
+    let (raw_cv, lut_cv) = (cv_of(&covered, "raw"), cv_of(&covered, "lut"));
     let better = raw_cv.iter().zip(&lut_cv).filter(|(r, l)| l < r).count();
     let _ = writeln!(
         md,
@@ -264,42 +349,17 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
             ""
         }
     );
-    Ok(json!({
-        "coverage": coverage,
-        "models_covered_only": rows[1],
-        "sequences": used,
-        "reference_samples": raw_reference.len(),
-        "reference_bins": reference.len(),
-        "samples": CLASSES.iter().zip(&classes).map(|(c, s)| json!({
-            "class": c.0, "name": c.1, "fit": s.fit.len(), "held_back": s.held.len()
-        })).collect::<Vec<_>>(),
-        "models": rows[0],
-    }))
+    Ok(md)
 }
 
-/// The table of CV and overlaps per model over the held-back samples (only those the LUT
-/// covers when `covered_only`), and its JSON rows.
+/// The JSON rows of CV and overlaps per model over the held-back samples (only those the LUT
+/// covers when `covered_only`).
 fn score(
     models: &[IntensityCorrection],
     classes: &[ClassSamples],
     lut: &IntensityLut,
     covered_only: bool,
-) -> (Table, Vec<Value>) {
-    let mut header = vec![if covered_only {
-        "model (real KITTI, frames 5–9, calibrated domain)".to_owned()
-    } else {
-        "model (real KITTI, held-back frames 5–9)".to_owned()
-    }];
-    header.extend(CLASSES.iter().map(|c| format!("CV {}", c.1)));
-    header.extend(
-        [
-            "overlap road–sidewalk",
-            "overlap road–building",
-            "overlap building–vegetation",
-        ]
-        .map(String::from),
-    );
-    let mut table = Table::new(header);
+) -> Vec<Value> {
     let mut rows = Vec::new();
     for model in models {
         let values: Vec<Vec<f64>> = classes
@@ -318,11 +378,41 @@ fn score(
         let (lo, hi) = (quantile(&mut pooled, 0.005), quantile(&mut pooled, 0.995));
         let ov = |i: usize, j: usize| overlap(&values[i], &values[j], lo, hi, 60);
         let overlaps = [ov(0, 1), ov(0, 2), ov(2, 3)];
-        let mut row = vec![model.name().to_owned()];
-        row.extend(cv.iter().map(|v| fmt_num(*v, 3)));
-        row.extend(overlaps.iter().map(|v| fmt_num(*v, 3)));
-        table.row(row);
         rows.push(json!({ "model": model.name(), "cv": cv, "overlap": overlaps }));
     }
-    (table, rows)
+    rows
+}
+
+/// The table of CV and overlaps per model from the JSON rows of [`score`].
+fn table(rows: &[Value], covered_only: bool) -> Table {
+    let mut header = vec![if covered_only {
+        "model (real KITTI, frames 5–9, calibrated domain)".to_owned()
+    } else {
+        "model (real KITTI, held-back frames 5–9)".to_owned()
+    }];
+    header.extend(CLASSES.iter().map(|c| format!("CV {}", c.1)));
+    header.extend(
+        [
+            "overlap road–sidewalk",
+            "overlap road–building",
+            "overlap building–vegetation",
+        ]
+        .map(String::from),
+    );
+    let mut table = Table::new(header);
+    for row in rows {
+        let numbers = |key: &str| -> Vec<String> {
+            row[key]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .map(|v| fmt_num(v.as_f64().unwrap_or(f64::NAN), 3))
+                .collect()
+        };
+        let mut cells = vec![row["model"].as_str().unwrap_or_default().to_owned()];
+        cells.extend(numbers("cv"));
+        cells.extend(numbers("overlap"));
+        table.row(cells);
+    }
+    table
 }

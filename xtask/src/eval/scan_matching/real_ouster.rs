@@ -3,20 +3,23 @@
 //! whose PCA normal is within [`GROUND_NORMAL_DEG`] of vertical. The LUT `I_ref(r, α)` is
 //! fitted on the ground of the even columns and scored on the odd ones, for the raw signal
 //! (where the packet profile carries it) and for the sensor's own calibrated reflectivity.
+//! One unit per capture.
 
 use std::fmt::Write;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use nalgebra::Point3;
 use raypath_io::ouster::{self, OusterFrame, SensorInfo, XyzLut};
 use raypath_reflectivity::lut::CalibrationSample;
 use raypath_reflectivity::normals::incidence_angle;
 use raypath_reflectivity::{IntensityCorrection, IntensityLut, LutConfig, RangePolynomial};
 use raypath_registration::{RegistrationConfig, surface_normals};
+use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 
-use super::coefficient_of_variation;
+use super::at;
 use super::real_calib::binned_means;
+use super::stats::coefficient_of_variation;
 use crate::eval::EvalContext;
 use crate::table::{Table, fmt_num};
 
@@ -38,6 +41,27 @@ const NORMAL_NEIGHBOURS: usize = 16;
 const NORMAL_RADIUS_M: f64 = 0.6;
 /// Every n-th return of a frame is used (normals of 130 k points per frame are slow).
 const STRIDE: usize = 2;
+
+/// The captures' names as units: the file names without `.pcap`.
+pub(super) fn captures() -> impl Iterator<Item = &'static str> {
+    CAPTURES
+        .iter()
+        .map(|&(file, _)| file.strip_suffix(".pcap").unwrap_or(file))
+}
+
+/// One capture's result.
+#[derive(Debug, Default, Serialize, Deserialize)]
+pub(super) struct CaptureUnit {
+    /// The sensor named in the table.
+    pub sensor: String,
+    /// Whether the capture is absent.
+    pub absent: bool,
+    /// The page's JSON rows (`capture`, `channel`, `model`, `fit`, `held_back`, `cv`,
+    /// `spearman_range`, `spearman_reflectivity`).
+    pub rows: Vec<Value>,
+    /// The channels left out, and why.
+    pub notes: Vec<String>,
+}
 
 /// Ground samples of one channel, split by column parity.
 #[derive(Default)]
@@ -122,8 +146,126 @@ fn spearman(a: &[f64], b: &[f64]) -> f64 {
     cov / (va * vb).sqrt()
 }
 
-/// Runs the section: writes its text and table into `md`, returns its JSON.
-pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
+/// The ground samples of every channel of `frames`, split by column parity: the sensor's
+/// reflectivity, and the raw signal where a frame carries it.
+fn channels(frames: &[OusterFrame], lut: &XyzLut) -> Result<Vec<(&'static str, Split)>> {
+    let mut channels: Vec<(&str, Split)> = vec![("reflectivity", Split::default())];
+    if frames.iter().any(|f| f.signal.is_some()) {
+        channels.push(("signal", Split::default()));
+    }
+    for frame in frames {
+        for g in ground_samples(frame, lut)? {
+            for (name, split) in &mut channels {
+                let intensity = if *name == "signal" {
+                    g.signal.unwrap_or(f64::NAN)
+                } else {
+                    g.reflectivity
+                };
+                let sample = CalibrationSample {
+                    range_m: g.range_m,
+                    incidence_rad: g.incidence_rad,
+                    intensity,
+                };
+                if g.column % 2 == 0 {
+                    split.fit.push(sample);
+                } else {
+                    split.held.push(sample);
+                    split.held_reflectivity.push(g.reflectivity);
+                }
+            }
+        }
+    }
+    Ok(channels)
+}
+
+/// Fits and scores the models on the ground of one capture (the unit `ouster/<capture>`).
+pub(super) fn measure(ctx: &EvalContext, capture: &str) -> Result<CaptureUnit> {
+    let Some(&(file, sensor)) = CAPTURES
+        .iter()
+        .find(|(file, _)| file.strip_suffix(".pcap") == Some(capture))
+    else {
+        bail!("no Ouster capture named {capture:?}");
+    };
+    let mut unit = CaptureUnit {
+        sensor: sensor.to_owned(),
+        ..CaptureUnit::default()
+    };
+    let pcap = ctx.data(&format!("ouster/{file}"));
+    if !pcap.is_file() {
+        eprintln!("scan-matching: {} absent, skipping it", pcap.display());
+        unit.absent = true;
+        return Ok(unit);
+    }
+    let json_path = ouster::find_metadata(&pcap)?;
+    let info = SensorInfo::read(&json_path)?;
+    let lut = XyzLut::new(&info)?;
+    let frames = ouster::read_frames(&pcap, &json_path)
+        .with_context(|| format!("reading {}", pcap.display()))?;
+    for (channel, split) in &channels(&frames, &lut)? {
+        let reference = binned_means(&split.fit);
+        if reference.len() < 3 || split.held.is_empty() {
+            unit.notes.push(format!(
+                "{sensor}: too little ground for the {channel} channel ({} ground returns \
+                 in the fit columns, {} (r, α) bins); left out.",
+                split.fit.len(),
+                reference.len()
+            ));
+            continue;
+        }
+        let table_lut = IntensityLut::fit(&reference, &LutConfig::default())?;
+        let poly = RangePolynomial::fit(&split.fit, 4, std::f64::consts::FRAC_PI_2)?;
+        let models = [
+            IntensityCorrection::Raw,
+            IntensityCorrection::Range(poly),
+            IntensityCorrection::Lut(table_lut),
+        ];
+        for model in &models {
+            unit.rows.push(score(file, channel, split, model));
+        }
+    }
+    Ok(unit)
+}
+
+/// One model on the held-back ground of one channel: the page's JSON row.
+fn score(file: &str, channel: &str, split: &Split, model: &IntensityCorrection) -> Value {
+    let (values, ranges, refl): (Vec<f64>, Vec<f64>, Vec<f64>) = split
+        .held
+        .iter()
+        .zip(&split.held_reflectivity)
+        .filter_map(|(s, &r)| {
+            let v = model.relative(s.intensity, s.range_m, s.incidence_rad)?;
+            v.is_finite().then_some((v, s.range_m, r))
+        })
+        .fold(Default::default(), |(mut a, mut b, mut c), (v, r, f)| {
+            a.push(v);
+            b.push(r);
+            c.push(f);
+            (a, b, c)
+        });
+    let cv = coefficient_of_variation(&values);
+    let with_range = spearman(&values, &ranges);
+    let with_reflectivity = (channel == "signal").then(|| spearman(&values, &refl));
+    json!({
+        "capture": file, "channel": channel, "model": model.name(),
+        "fit": split.fit.len(), "held_back": split.held.len(), "cv": cv,
+        "spearman_range": with_range, "spearman_reflectivity": with_reflectivity,
+    })
+}
+
+/// The section from every capture's result: its text and table, the notes and the finding
+/// on the signal channel, and its JSON.
+pub(super) fn section(ctx: &EvalContext, captures: &[CaptureUnit]) -> Result<(String, Value)> {
+    let mut md = String::new();
+    let rows: Vec<Value> = captures.iter().flat_map(|c| c.rows.clone()).collect();
+    let notes: Vec<String> = captures.iter().flat_map(|c| c.notes.clone()).collect();
+    if rows.is_empty() {
+        let _ = writeln!(
+            md,
+            "*Skipped: no Ouster captures under `{}`.*\n",
+            ctx.data("ouster").display()
+        );
+        return Ok((md, json!({ "skipped": "no Ouster captures" })));
+    }
     let mut table = Table::new([
         "capture (real)",
         "channel",
@@ -133,105 +275,21 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
         "Spearman with range",
         "Spearman with sensor reflectivity",
     ]);
-    let mut rows = Vec::new();
-    let mut notes = Vec::new();
-    for (file, sensor) in CAPTURES {
-        let pcap = ctx.data(&format!("ouster/{file}"));
-        if !pcap.is_file() {
-            eprintln!("scan-matching: {} absent, skipping it", pcap.display());
-            continue;
+    for capture in captures {
+        for row in &capture.rows {
+            let text = |key: &str| row[key].as_str().unwrap_or_default().to_owned();
+            table.row([
+                capture.sensor.clone(),
+                text("channel"),
+                format!("{} / {}", row["fit"], row["held_back"]),
+                text("model"),
+                fmt_num(at(row, "/cv"), 3),
+                fmt_num(at(row, "/spearman_range"), 2),
+                row["spearman_reflectivity"]
+                    .as_f64()
+                    .map_or("—".into(), |v| fmt_num(v, 2)),
+            ]);
         }
-        let json_path = ouster::find_metadata(&pcap)?;
-        let info = SensorInfo::read(&json_path)?;
-        let lut = XyzLut::new(&info)?;
-        let frames = ouster::read_frames(&pcap, &json_path)
-            .with_context(|| format!("reading {}", pcap.display()))?;
-        let mut channels: Vec<(&str, Split)> = vec![("reflectivity", Split::default())];
-        if frames.iter().any(|f| f.signal.is_some()) {
-            channels.push(("signal", Split::default()));
-        }
-        for frame in &frames {
-            for g in ground_samples(frame, &lut)? {
-                for (name, split) in &mut channels {
-                    let intensity = if *name == "signal" {
-                        g.signal.unwrap_or(f64::NAN)
-                    } else {
-                        g.reflectivity
-                    };
-                    let sample = CalibrationSample {
-                        range_m: g.range_m,
-                        incidence_rad: g.incidence_rad,
-                        intensity,
-                    };
-                    if g.column % 2 == 0 {
-                        split.fit.push(sample);
-                    } else {
-                        split.held.push(sample);
-                        split.held_reflectivity.push(g.reflectivity);
-                    }
-                }
-            }
-        }
-        for (channel, split) in &channels {
-            let reference = binned_means(&split.fit);
-            if reference.len() < 3 || split.held.is_empty() {
-                notes.push(format!(
-                    "{sensor}: too little ground for the {channel} channel ({} ground returns \
-                     in the fit columns, {} (r, α) bins); left out.",
-                    split.fit.len(),
-                    reference.len()
-                ));
-                continue;
-            }
-            let table_lut = IntensityLut::fit(&reference, &LutConfig::default())?;
-            let poly = RangePolynomial::fit(&split.fit, 4, std::f64::consts::FRAC_PI_2)?;
-            let models = [
-                IntensityCorrection::Raw,
-                IntensityCorrection::Range(poly),
-                IntensityCorrection::Lut(table_lut),
-            ];
-            for model in &models {
-                let (values, ranges, refl): (Vec<f64>, Vec<f64>, Vec<f64>) = split
-                    .held
-                    .iter()
-                    .zip(&split.held_reflectivity)
-                    .filter_map(|(s, &r)| {
-                        let v = model.relative(s.intensity, s.range_m, s.incidence_rad)?;
-                        v.is_finite().then_some((v, s.range_m, r))
-                    })
-                    .fold(Default::default(), |(mut a, mut b, mut c), (v, r, f)| {
-                        a.push(v);
-                        b.push(r);
-                        c.push(f);
-                        (a, b, c)
-                    });
-                let cv = coefficient_of_variation(&values);
-                let with_range = spearman(&values, &ranges);
-                let with_reflectivity = (*channel == "signal").then(|| spearman(&values, &refl));
-                table.row([
-                    sensor.to_owned(),
-                    (*channel).to_owned(),
-                    format!("{} / {}", split.fit.len(), split.held.len()),
-                    model.name().to_owned(),
-                    fmt_num(cv, 3),
-                    fmt_num(with_range, 2),
-                    with_reflectivity.map_or("—".into(), |v| fmt_num(v, 2)),
-                ]);
-                rows.push(json!({
-                    "capture": file, "channel": channel, "model": model.name(),
-                    "fit": split.fit.len(), "held_back": split.held.len(), "cv": cv,
-                    "spearman_range": with_range, "spearman_reflectivity": with_reflectivity,
-                }));
-            }
-        }
-    }
-    if rows.is_empty() {
-        let _ = writeln!(
-            md,
-            "*Skipped: no Ouster captures under `{}`.*\n",
-            ctx.data("ouster").display()
-        );
-        return Ok(json!({ "skipped": "no Ouster captures" }));
     }
     let _ = writeln!(
         md,
@@ -254,7 +312,7 @@ pub fn run(ctx: &EvalContext, md: &mut String) -> Result<Value> {
     if let Some(finding) = signal_finding(&rows) {
         let _ = writeln!(md, "\n{finding}\n");
     }
-    Ok(json!({ "rows": rows, "notes": notes }))
+    Ok((md, json!({ "rows": rows, "notes": notes })))
 }
 
 /// One sentence on the signal channel: what the corrections do to its spread, its range

@@ -7,6 +7,7 @@
 use anyhow::Result;
 use raypath_geometry::PointCloud;
 use raypath_planes::{MsacParams, PeacParams, PpeParams};
+use serde::{Deserialize, Serialize};
 
 use crate::eval::EvalContext;
 use crate::eval::planes::{
@@ -272,6 +273,7 @@ pub fn label(method: &Method) -> String {
 }
 
 /// One grid cell and its scores on the training images.
+#[derive(Serialize, Deserialize)]
 pub struct Cell {
     /// The method and its parameters.
     pub method: Method,
@@ -289,7 +291,8 @@ impl Cell {
     }
 }
 
-/// What the protocol gives for one data set.
+/// What the protocol gives for one data set (serde: a unit's result carries it).
+#[derive(Serialize, Deserialize)]
 pub struct Outcome {
     /// Per method (PPE, PEAC-style, MSAC) the grid cells, best first (empty without
     /// training images).
