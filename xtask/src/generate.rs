@@ -74,6 +74,20 @@ pub fn ensure(name: &str, quick: bool) -> Result<PathBuf> {
     Ok(dir)
 }
 
+/// The raw log and the corrected log of the generated `indoor` world `world`
+/// (`<world>.clf` and `<world>-corrected.log`, plain or compressed), generating the set
+/// first when needed; `None` when the set has no such world.
+pub fn indoor_logs(world: &str, quick: bool) -> Result<Option<(PathBuf, PathBuf)>> {
+    let dir = ensure("indoor", quick)?;
+    let find = |stem: String| {
+        ["", ".gz", ".bz2"]
+            .iter()
+            .map(|ext| dir.join(format!("{stem}{ext}")))
+            .find(|p| p.exists())
+    };
+    Ok(find(format!("{world}.clf")).zip(find(format!("{world}-corrected.log"))))
+}
+
 /// The real input a set needs and the data directory lacks, if any.
 fn missing_input(set: &SetSpec) -> Option<String> {
     let required = set.requires?;

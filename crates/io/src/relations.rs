@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 
 use raypath_geometry::Pose2;
 
-use crate::source::{LineReader, parse_field};
+use crate::source::{LineReader, finite_fields};
 use crate::{Error, Location, Result};
 
 /// One relation: the reference pose of scan `b` in the frame of scan `a`.
@@ -62,20 +62,12 @@ fn relations_from(mut lines: LineReader) -> Result<Vec<Relation>> {
         if line.is_empty() || line.starts_with('#') {
             continue;
         }
-        let mut fields = line.split_whitespace();
-        let mut v = [0.0f64; 8];
-        for (value, name) in v.iter_mut().zip(FIELDS) {
-            *value = parse_field(&lines, fields.next(), name)?;
-            if !value.is_finite() {
-                return Err(lines.error(format!("{name} is {value}")));
-            }
-        }
-        if fields.next().is_some() {
-            return Err(lines.error(
-                "more than 8 numbers (expected `timestamp1 timestamp2 x y z roll pitch yaw`)",
-            ));
-        }
-        let [a, b, x, y, _z, _roll, _pitch, yaw] = v;
+        let [a, b, x, y, _z, _roll, _pitch, yaw] = finite_fields(
+            &lines,
+            &line,
+            FIELDS,
+            "timestamp1 timestamp2 x y z roll pitch yaw",
+        )?;
         relations.push(Relation {
             stamp_a_secs: a,
             stamp_b_secs: b,

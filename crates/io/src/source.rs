@@ -267,6 +267,28 @@ pub fn parse_field<T: std::str::FromStr>(
         .map_err(|_| lines.error(format!("{what}: cannot parse {text:?}")))
 }
 
+/// Parses the whitespace-separated fields of `line` as exactly `N` finite numbers named
+/// `names` (errors name the field; `layout` describes the line for the too-many error).
+pub fn finite_fields<const N: usize>(
+    lines: &LineReader,
+    line: &str,
+    names: [&str; N],
+    layout: &str,
+) -> Result<[f64; N]> {
+    let mut fields = line.split_whitespace();
+    let mut v = [0.0f64; N];
+    for (value, name) in v.iter_mut().zip(names) {
+        *value = parse_field(lines, fields.next(), name)?;
+        if !value.is_finite() {
+            return Err(lines.error(format!("{name} is {value}")));
+        }
+    }
+    if fields.next().is_some() {
+        return Err(lines.error(format!("more than {N} numbers (expected `{layout}`)")));
+    }
+    Ok(v)
+}
+
 /// Reads little- and big-endian binary values while counting the byte offset.
 pub struct ByteReader<R> {
     path: PathBuf,

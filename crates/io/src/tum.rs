@@ -8,7 +8,7 @@ use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use raypath_geometry::Pose3;
 
 use crate::Result;
-use crate::source::{LineReader, parse_field};
+use crate::source::{LineReader, finite_fields};
 
 /// One stamped pose of a TUM trajectory.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,18 +40,8 @@ fn tum_from(mut lines: LineReader) -> Result<Vec<TumPose>> {
         if line.is_empty() || line.starts_with('#') {
             continue;
         }
-        let mut fields = line.split_whitespace();
-        let mut v = [0.0f64; 8];
-        for (value, name) in v.iter_mut().zip(FIELDS) {
-            *value = parse_field(&lines, fields.next(), name)?;
-            if !value.is_finite() {
-                return Err(lines.error(format!("{name} is {value}")));
-            }
-        }
-        if fields.next().is_some() {
-            return Err(lines.error("more than 8 numbers (expected `t x y z qx qy qz qw`)"));
-        }
-        let [t, x, y, z, qx, qy, qz, qw] = v;
+        let [t, x, y, z, qx, qy, qz, qw] =
+            finite_fields(&lines, &line, FIELDS, "t x y z qx qy qz qw")?;
         let q = Quaternion::new(qw, qx, qy, qz);
         if q.norm() < 1e-9 {
             return Err(lines.error("zero quaternion"));

@@ -5,6 +5,8 @@
 
 use std::io::Cursor;
 
+mod common;
+
 use proptest::prelude::*;
 use raypath_io::Location;
 use raypath_io::data::require;
@@ -119,18 +121,7 @@ proptest! {
         invalid_utf8 in any::<bool>(),
     ) {
         let source = b"x,y,w\n8.1320,-1.7499,0.0468\n-5.5911,6.3091,0.0504\n1e3,2,3\n";
-        let len = ((source.len() as f64) * cut) as usize;
-        let mut bytes = source[..len].to_vec();
-        for &(at, c) in &edits {
-            if !bytes.is_empty() {
-                let i = at % bytes.len();
-                bytes[i] = ALPHABET[c % ALPHABET.len()];
-            }
-        }
-        if invalid_utf8 && !bytes.is_empty() {
-            let i = edits.first().map_or(0, |e| e.0 % bytes.len());
-            bytes[i] = 0xfe;
-        }
+        let bytes = common::mutated(source, cut, &edits, invalid_utf8, ALPHABET);
         match PointCsv::parse(Cursor::new(bytes), "p.csv") {
             Ok(csv) => {
                 prop_assert_eq!(csv.values.len(), csv.len() * csv.columns.len());

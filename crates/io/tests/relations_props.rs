@@ -3,6 +3,8 @@
 
 use std::io::Cursor;
 
+mod common;
+
 use proptest::prelude::*;
 use raypath_io::Location;
 use raypath_io::relations::parse_relations;
@@ -23,18 +25,7 @@ proptest! {
         edits in prop::collection::vec((any::<usize>(), any::<usize>()), 0..5),
         invalid_utf8 in any::<bool>(),
     ) {
-        let len = ((SOURCE.len() as f64) * cut) as usize;
-        let mut bytes = SOURCE[..len].to_vec();
-        for &(at, c) in &edits {
-            if !bytes.is_empty() {
-                let i = at % bytes.len();
-                bytes[i] = ALPHABET[c % ALPHABET.len()];
-            }
-        }
-        if invalid_utf8 && !bytes.is_empty() {
-            let i = edits.first().map_or(0, |e| e.0 % bytes.len());
-            bytes[i] = 0xfe;
-        }
+        let bytes = common::mutated(SOURCE, cut, &edits, invalid_utf8, ALPHABET);
         match parse_relations(Cursor::new(bytes), "r.relations") {
             Ok(relations) => {
                 prop_assert!(relations.len() <= 3);

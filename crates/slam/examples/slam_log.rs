@@ -90,6 +90,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(d) = env("SLAM_NODE_DIST") {
         config.submaps.node_distance_m = d;
     }
+    if let (Some(m), Some(l)) = (env("SLAM_MIN_SCORE"), config.loops.as_mut()) {
+        l.correlative.min_score = m;
+    }
+    if let (Some(w), Some(l)) = (env("SLAM_WINDOW"), config.loops.as_mut()) {
+        l.max_linear_window_m = w;
+        l.linear_window_m = w.min(l.linear_window_m);
+    }
+    if let (Some(g), Some(l)) = (env("SLAM_GROWTH"), config.loops.as_mut()) {
+        l.radius_growth = g;
+    }
     if let Some(r) = env("SLAM_RANGE") {
         config.filter.max_range_m = r;
     }

@@ -203,20 +203,13 @@ fn planar_data(ctx: &EvalContext, name: &str) -> Result<Option<PlanarData>> {
             None => bail!("mcl: no data set {name:?}"),
         },
     };
-    let indoor = crate::generate::ensure("indoor", ctx.quick)?;
-    let find = |stem: &str| {
-        ["", ".gz", ".bz2"]
-            .iter()
-            .map(|ext| indoor.join(format!("{stem}{ext}")))
-            .find(|p| p.exists())
-    };
-    Ok(find(&format!("{world}.clf"))
-        .zip(find(&format!("{world}-corrected.log")))
-        .map(|(raw, corrected)| PlanarData {
+    Ok(
+        crate::generate::indoor_logs(world, ctx.quick)?.map(|(raw, corrected)| PlanarData {
             real: false,
             raw,
             corrected,
-        }))
+        }),
+    )
 }
 
 /// What one unit measured.

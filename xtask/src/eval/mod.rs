@@ -129,9 +129,32 @@ pub struct EvalReport {
     pub headline: Option<String>,
 }
 
+/// The SLAM benchmark's raw logs that have a corrected log in the data set: name, raw log,
+/// corrected log (under the data directory).
+pub(crate) const BENCHMARK_LOGS: [(&str, &str, &str); 3] = [
+    (
+        "intel",
+        "carmen/raw/intel.clf.bz2",
+        "carmen/corrected/intel-corrected.log.gz",
+    ),
+    (
+        "fr079",
+        "carmen/raw/fr079.clf.bz2",
+        "carmen/corrected/freiburg-079-corrected.log.gz",
+    ),
+    (
+        "mit-csail",
+        "carmen/raw/mit-csail.clf.bz2",
+        "carmen/corrected/csail-corrected.log.gz",
+    ),
+];
+
 /// How an evaluation runs: one function, or in stages (then `--shard` and `merge` work).
 enum Runner {
-    /// The whole evaluation in one call.
+    /// The whole evaluation in one call (still measure, then a tested report function).
+    /// Kept for `io`, `geometry`, `sim` and `memory`: they take seconds to a few minutes, and
+    /// `geometry` and `memory` measure the machine itself (throughput, peak memory beside
+    /// OctoMap in the same run), which shards on other machines would mix.
     Whole(fn(&EvalContext) -> Result<EvalReport>),
     /// Units, then the report ([`stages::run_all`]).
     Staged(&'static stages::Staged),

@@ -38,23 +38,7 @@ const SEED: u64 = 2009;
 const RANDOM_PAIRS: usize = 1000;
 
 /// Logs with a corrected log: name, raw log, corrected log.
-const REFERENCED: [(&str, &str, &str); 3] = [
-    (
-        "intel",
-        "carmen/raw/intel.clf.bz2",
-        "carmen/corrected/intel-corrected.log.gz",
-    ),
-    (
-        "fr079",
-        "carmen/raw/fr079.clf.bz2",
-        "carmen/corrected/freiburg-079-corrected.log.gz",
-    ),
-    (
-        "mit-csail",
-        "carmen/raw/mit-csail.clf.bz2",
-        "carmen/corrected/csail-corrected.log.gz",
-    ),
-];
+const REFERENCED: [(&str, &str, &str); 3] = super::BENCHMARK_LOGS;
 
 /// Logs without a reference: name, raw log.
 const UNREFERENCED: [(&str, &str); 4] = [
@@ -381,17 +365,7 @@ fn unreferenced(ctx: &EvalContext, name: &str, raw: &str) -> Result<Value> {
 /// Occupancy against combined residual on one generated indoor world with remissions
 /// (simulated): the same SLAM with the simulator's intensity LUT.
 fn ablation(ctx: &EvalContext, world: &str) -> Result<Value> {
-    let dir = crate::generate::ensure("indoor", ctx.quick)?;
-    let find = |stem: &str| {
-        ["", ".gz", ".bz2"]
-            .iter()
-            .map(|ext| dir.join(format!("{stem}{ext}")))
-            .find(|p| p.exists())
-    };
-    let (Some(raw), Some(corrected)) = (
-        find(&format!("{world}.clf")),
-        find(&format!("{world}-corrected.log")),
-    ) else {
+    let Some((raw, corrected)) = crate::generate::indoor_logs(world, ctx.quick)? else {
         return Ok(json!({
             "skipped": format!("the generated `indoor/{world}` logs are missing: skipped.")
         }));

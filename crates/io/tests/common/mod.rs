@@ -1,4 +1,5 @@
-//! Helpers shared by the rosbag2 tests: poses and scans compared within tolerances.
+//! Helpers shared by the tests: poses and scans compared within tolerances (rosbag2 tests),
+//! mutated input for the text readers' property tests.
 #![allow(dead_code)] // not every test file uses every helper
 
 use raypath_geometry::{Pose2, Pose3, Range, Scan2};
@@ -57,4 +58,29 @@ pub fn assert_same_scan(a: &Scan2, b: &Scan2, what: &str) {
         (None, None) => {}
         _ => panic!("{what}: intensities present in one only"),
     }
+}
+
+/// `source` cut to the fraction `cut` of its length, with the bytes at `edits` (positions
+/// modulo the length) replaced by characters of `alphabet`, and one byte made invalid UTF-8
+/// when `invalid_utf8` is set: the mutated input of the text readers' property tests.
+pub fn mutated(
+    source: &[u8],
+    cut: f64,
+    edits: &[(usize, usize)],
+    invalid_utf8: bool,
+    alphabet: &[u8],
+) -> Vec<u8> {
+    let len = ((source.len() as f64) * cut) as usize;
+    let mut bytes = source[..len].to_vec();
+    for &(at, c) in edits {
+        if !bytes.is_empty() {
+            let i = at % bytes.len();
+            bytes[i] = alphabet[c % alphabet.len()];
+        }
+    }
+    if invalid_utf8 && !bytes.is_empty() {
+        let i = edits.first().map_or(0, |e| e.0 % bytes.len());
+        bytes[i] = 0xfe;
+    }
+    bytes
 }

@@ -37,14 +37,7 @@ pub(super) struct LabUnit {
 
 /// Matches the generated world (the unit `generated-lab`).
 pub(super) fn measure(ctx: &EvalContext) -> Result<Option<LabUnit>> {
-    let dir = crate::generate::ensure("indoor", ctx.quick)?;
-    let find = |stem: &str| {
-        ["", ".gz", ".bz2"]
-            .iter()
-            .map(|ext| dir.join(format!("{stem}{ext}")))
-            .find(|p| p.exists())
-    };
-    let (Some(raw_file), Some(ref_file)) = (find("lab.clf"), find("lab-corrected.log")) else {
+    let Some((raw_file, ref_file)) = crate::generate::indoor_logs("lab", ctx.quick)? else {
         return Ok(None);
     };
     let lut = simulated_lut(reference_count(ctx.quick))?;

@@ -21,23 +21,7 @@ use crate::eval::{EvalContext, comparable};
 use crate::table::{Table, fmt_num};
 
 /// The real logs: name, raw log, corrected log.
-const LOGS: [(&str, &str, &str); 3] = [
-    (
-        "intel",
-        "carmen/raw/intel.clf.bz2",
-        "carmen/corrected/intel-corrected.log.gz",
-    ),
-    (
-        "fr079",
-        "carmen/raw/fr079.clf.bz2",
-        "carmen/corrected/freiburg-079-corrected.log.gz",
-    ),
-    (
-        "mit-csail",
-        "carmen/raw/mit-csail.clf.bz2",
-        "carmen/corrected/csail-corrected.log.gz",
-    ),
-];
+const LOGS: [(&str, &str, &str); 3] = crate::eval::BENCHMARK_LOGS;
 
 /// Scans per log with `--quick`.
 const QUICK_SCANS: usize = 600;

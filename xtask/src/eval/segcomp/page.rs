@@ -4,7 +4,7 @@
 use anyhow::{Context, Result};
 use serde_json::Value;
 
-use super::protocol::{self, Outcome};
+use super::protocol::{self, HOOVER_COLUMNS, Outcome};
 use super::standin::{self, StandinUnit};
 use super::{NAME, REAL, RealMeasured, RealUnit, STANDIN};
 use crate::eval::stages::UnitResults;
@@ -149,7 +149,7 @@ fn real_section(ctx: &EvalContext, real: Option<&RealMeasured>) -> Result<String
             root.join("perceptron/test").display()
         ));
     };
-    let mut results = Table::new(protocol::RESULT_HEADER);
+    let mut results = Table::new(protocol::result_header());
     protocol::results_rows(
         &mut results,
         "real SegComp Perceptron, test",
@@ -172,7 +172,7 @@ fn standin_section(
 ) -> Result<String> {
     let outcome = &standin.outcome;
     let describe = standin::describe(&standin::config(ctx.quick), &standin.train, &standin.test);
-    let mut sim_results = Table::new(protocol::RESULT_HEADER);
+    let mut sim_results = Table::new(protocol::result_header());
     protocol::results_rows(
         &mut sim_results,
         "simulated stand-in, test",
@@ -212,18 +212,10 @@ fn thesis_table(real: bool) -> Table {
     } else {
         comparable::no(NOT_SEGCOMP)
     };
-    let mut thesis = Table::new([
-        "method (thesis, SegComp Perceptron test)",
-        "f [%]",
-        "k [%]",
-        "RMSE [mm]",
-        "α [°]",
-        "n_o",
-        "n_u",
-        "n_m",
-        "n_s",
-        comparable::HEADER,
-    ]);
+    let mut header = vec!["method (thesis, SegComp Perceptron test)"];
+    header.extend(HOOVER_COLUMNS);
+    header.push(comparable::HEADER);
+    let mut thesis = Table::new(header);
     for row in THESIS {
         let mut cells: Vec<String> = row.iter().map(|c| (*c).to_owned()).collect();
         cells.push(verdict.clone());

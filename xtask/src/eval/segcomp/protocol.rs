@@ -374,14 +374,8 @@ fn mean_finite(scores: &[HooverScore], f: impl Fn(&HooverScore) -> f64) -> f64 {
     }
 }
 
-/// The header of [`results_rows`].
-pub const RESULT_HEADER: [&str; 16] = [
-    "data",
-    "method",
-    "parameters (best on train)",
-    "images",
-    "GT planes",
-    "planes",
+/// The Hoover et al. (1996) figures of a segmentation, as the tables name them.
+pub const HOOVER_COLUMNS: [&str; 8] = [
     "f [%]",
     "k [%]",
     "RMSE [mm]",
@@ -390,11 +384,24 @@ pub const RESULT_HEADER: [&str; 16] = [
     "n_u",
     "n_m",
     "n_s",
-    "time/image [s]",
-    crate::eval::comparable::HEADER,
 ];
 
-/// One row per method of `outcome` into `table` (header [`RESULT_HEADER`]): means over the
+/// The header of [`results_rows`].
+pub fn result_header() -> Vec<&'static str> {
+    let mut header = vec![
+        "data",
+        "method",
+        "parameters (best on train)",
+        "images",
+        "GT planes",
+        "planes",
+    ];
+    header.extend(HOOVER_COLUMNS);
+    header.extend(["time/image [s]", crate::eval::comparable::HEADER]);
+    header
+}
+
+/// One row per method of `outcome` into `table` (header [`result_header`]): means over the
 /// test images (α over the images where it is defined), median time.
 pub fn results_rows(table: &mut Table, data: &str, outcome: &Outcome, comparable: &str) {
     for (method, scores) in outcome.chosen.iter().zip(&outcome.test) {
@@ -587,7 +594,7 @@ mod tests {
         assert!(outcome.test.iter().all(|s| s.len() == 2));
         // PPE finds planes in these images.
         assert!(test_f(&outcome, 0) > 0.0);
-        let mut table = Table::new(RESULT_HEADER);
+        let mut table = Table::new(result_header());
         results_rows(&mut table, "simulated", &outcome, "no — test");
         assert_eq!(table.to_markdown().unwrap().lines().count(), 5);
         assert!(grid_table("simulated", &outcome, 2).to_markdown().is_ok());
