@@ -288,7 +288,7 @@ impl RtreeGrid {
             Selection::BeamSamples { spacing_cells } => 1.0 / spacing_cells,
             Selection::UpdatedCells => 1.0,
         };
-        let mut rng = ray::SplitMix(self.config.seed ^ self.scans.wrapping_mul(0x9E37_79B9));
+        let mut rng = ray::SplitMix::new(self.config.seed ^ self.scans.wrapping_mul(0x9E37_79B9));
         let fusion = self.config.fusion;
         // Look-ups run a chunk of keys ahead of the updates (independent memory accesses
         // overlap): they stay valid, as fused cells do not change during this loop (their

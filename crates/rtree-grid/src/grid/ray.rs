@@ -8,6 +8,8 @@
 //! runs on integer keys.)
 
 use nalgebra::Point3;
+use rand_xoshiro::SplitMix64;
+use rand_xoshiro::rand_core::{RngCore, SeedableRng};
 
 use super::{RtreeGrid, ScanUpdate, SensorModel};
 use crate::key::{KEY_OFFSET, key_of, pack};
@@ -197,19 +199,19 @@ impl RecentKeys {
     }
 }
 
-/// SplitMix64, a tiny seeded generator for the beam samples.
-pub(crate) struct SplitMix(pub u64);
+/// The seeded generator of the beam samples: SplitMix64 (`rand_xoshiro`), 8 bytes of state.
+pub(crate) struct SplitMix(SplitMix64);
 
 impl SplitMix {
-    /// Next value in `[0, 1)`.
+    /// The generator with state `seed`.
+    pub(crate) fn new(seed: u64) -> Self {
+        Self(SplitMix64::seed_from_u64(seed))
+    }
+
+    /// Next value in `[0, 1)` (the top 53 bits of the next output).
     #[inline]
     pub(crate) fn next_f64(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
+        (self.0.next_u64() >> 11) as f64 / (1u64 << 53) as f64
     }
 }
 

@@ -20,7 +20,7 @@ fn check(grid: &RtreeGrid) -> u64 {
 }
 
 fn scan_points(seed: u64, n: usize) -> Vec<Point3<f64>> {
-    let mut rng = ray::SplitMix(seed);
+    let mut rng = ray::SplitMix::new(seed);
     (0..n)
         .map(|_| {
             // A box room 6 × 4 × 3 m around the origin, walls as end points.
@@ -297,7 +297,8 @@ fn assert_matches_plain(grid: &RtreeGrid, reference: &RtreeGrid, tolerance: f32)
 fn moving_scans(seed: u64, scans: usize, points: usize) -> Vec<(Point3<f64>, Vec<Point3<f64>>)> {
     (0..scans)
         .map(|i| {
-            let mut rng = ray::SplitMix(seed ^ (i as u64 + 1).wrapping_mul(0xA24B_AED4_963E_E407));
+            let mut rng =
+                ray::SplitMix::new(seed ^ (i as u64 + 1).wrapping_mul(0xA24B_AED4_963E_E407));
             let origin = Point3::new(
                 -2.0 + 4.0 * rng.next_f64(),
                 -1.5 + 3.0 * rng.next_f64(),
