@@ -194,7 +194,7 @@ const EVALUATIONS: &[(&str, &str, Runner)] = &[
     (
         "sensor-models",
         "sensor models scored at the true pose and by inverse KL (Schaefer Tables 7.3, 8.2, 8.3)",
-        Runner::Whole(sensor_models::run),
+        Runner::Staged(&sensor_models::STAGED),
     ),
     (
         "mcl",
@@ -254,7 +254,7 @@ const EVALUATIONS: &[(&str, &str, Runner)] = &[
     (
         "place-recognition",
         "IBuILD loop closure and lidar place recognition beside DBoW2, Scan Context, HOG, GIST, SHOT (Khan ch. 4)",
-        Runner::Whole(place_recognition::run),
+        Runner::Staged(&place_recognition::STAGED),
     ),
     (
         "registration",

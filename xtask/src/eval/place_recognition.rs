@@ -21,11 +21,27 @@
 //! semi-synthetic stretch of sequence 00, speed at 1 000 frames. `PLACE_RECOGNITION_SECTIONS=1,4`
 //! runs only the listed sections; `PLACE_RECOGNITION_STRIDE` sets the frame stride of the full
 //! semi-synthetic drives (default 10).
+//!
+//! In stages: one unit per fold of section 1 (`real-2d/fold-0`, `real-2d/fold-1`: a fold's
+//! logs share the DBoW2-style vocabulary trained on the other fold, so the fold is the unit and
+//! trains it once), one for section 2 (`real-3d`: one database of all real frames), one for the
+//! note on simulated scans under section 3's heading (`simulation-gap`, measured whichever
+//! sections run), one per sequence of section 3 (`semi-kitti/00` …) and one for section 4
+//! (`speed`); the page ([`page`]) from their results alone, section 5 (quoted) in the report
+//! stage. The folds and sequences hand over the cells of their table rows, pictures and JSON;
+//! the single units of sections 2 and 4 hand over their section's text and JSON. A unit of a section left out by `PLACE_RECOGNITION_SECTIONS` measures nothing and
+//! says so; its section reads "Skipped". The 3-D vocabulary ([`methods::kitti_vocabulary`],
+//! seeded) is shared by sections 2 and 3: every unit that needs it trains it again (the same
+//! bytes each time) rather than joining the sections into one unit — it is cheap beside a
+//! section (quick: intensity images of 21 simulated scans along sequence 03, 2 s in a release
+//! build, against 15 s for the quick semi-synthetic sequence; full: 81 scans), and the
+//! sequences of section 3 stay units of their own.
 
 mod camera;
 mod data2d;
 mod kitti_real;
 mod methods;
+mod page;
 mod plot;
 mod real2d;
 mod report;
@@ -34,25 +50,143 @@ mod semi_kitti;
 mod speed;
 mod truth;
 
-use std::fmt::Write;
+use std::sync::Arc;
 
-use anyhow::Result;
-use serde_json::{Value, json};
+use anyhow::{Result, bail};
+use raypath_place_recognition::BinaryVocabulary;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
 
 use self::runner::MethodResult;
-use super::{EvalContext, EvalReport, comparable};
-use crate::table::Table;
+use super::EvalContext;
+use super::stages::{self, Staged, UnitResults};
 
 const NAME: &str = "place-recognition";
 /// Folder of the pictures under `docs/results/`.
 const FIGURES: &str = "place-recognition";
+/// Selects the sections to run (`1,4`); unset: all.
+const SECTIONS_VAR: &str = "PLACE_RECOGNITION_SECTIONS";
+
+/// The evaluation in stages (`--shard i/n` and `eval merge`).
+pub const STAGED: Staged = Staged {
+    name: NAME,
+    units,
+    run_unit,
+    report,
+};
 
 /// The markdown and JSON of one section.
+#[derive(Serialize, Deserialize)]
 pub struct Section {
     markdown: String,
     json: Value,
     /// One-line findings for the summary at the top.
     summary: Vec<String>,
+}
+
+/// What one unit measured.
+#[derive(Serialize, Deserialize)]
+enum UnitResult {
+    /// The unit's section is left out by `PLACE_RECOGNITION_SECTIONS`.
+    Skipped,
+    /// A fold of section 1.
+    Real2d(real2d::FoldResult),
+    /// Section 2 and the note on the 3-D vocabulary.
+    Real3d {
+        section: Section,
+        vocabulary_note: String,
+    },
+    /// A sequence of section 3 and the note on the 3-D vocabulary.
+    SemiKitti {
+        sequence: semi_kitti::SequenceResult,
+        vocabulary_note: String,
+    },
+    /// Section 4.
+    Speed(Section),
+    /// The note on how far simulated scans are from real ones (under section 3's heading,
+    /// measured whichever sections run).
+    SimulationGap(String),
+}
+
+/// The units in report order: the folds of section 1, section 2, the note on simulated scans,
+/// the sequences of section 3, section 4.
+fn units(ctx: &EvalContext) -> Result<Vec<String>> {
+    let mut units: Vec<String> = (0..real2d::FOLD_COUNT)
+        .map(|fold| format!("real-2d/fold-{fold}"))
+        .collect();
+    units.extend(["real-3d".into(), SIMULATION_GAP.into()]);
+    units.extend(
+        semi_kitti::sequences(ctx.quick)
+            .into_iter()
+            .map(|s| format!("semi-kitti/{s}")),
+    );
+    units.push("speed".into());
+    Ok(units)
+}
+
+/// The unit of the note on simulated scans.
+const SIMULATION_GAP: &str = "simulation-gap";
+
+/// The section (1–4) a unit belongs to; `None` for the note on simulated scans (on the page
+/// whichever sections run).
+fn section_of(unit: &str) -> Result<Option<&'static str>> {
+    Ok(Some(match unit.split('/').next() {
+        Some("real-2d") => "1",
+        Some("real-3d") => "2",
+        Some("semi-kitti") => "3",
+        Some("speed") => "4",
+        Some(SIMULATION_GAP) => return Ok(None),
+        _ => bail!("no unit {unit:?} in {NAME}"),
+    }))
+}
+
+/// Whether `PLACE_RECOGNITION_SECTIONS` (unset: all) selects section `k`.
+fn wanted(k: &str) -> bool {
+    std::env::var(SECTIONS_VAR)
+        .ok()
+        .is_none_or(|v| v.split(',').any(|s| s.trim() == k))
+}
+
+/// Measures one unit (nothing when its section is not selected).
+fn run_unit(ctx: &EvalContext, unit: &str) -> Result<Value> {
+    let result = if !section_of(unit)?.is_none_or(wanted) {
+        UnitResult::Skipped
+    } else if unit == SIMULATION_GAP {
+        UnitResult::SimulationGap(super::sim::gap_note(ctx)?)
+    } else if let Some(fold) = unit.strip_prefix("real-2d/fold-") {
+        UnitResult::Real2d(real2d::run_fold(ctx, fold.parse()?)?)
+    } else if unit == "real-3d" {
+        let (vocabulary, vocabulary_note) = vocabulary_3d(ctx)?;
+        UnitResult::Real3d {
+            section: kitti_real::run(ctx, vocabulary.as_ref())?,
+            vocabulary_note,
+        }
+    } else if let Some(sequence) = unit.strip_prefix("semi-kitti/") {
+        let (vocabulary, vocabulary_note) = vocabulary_3d(ctx)?;
+        UnitResult::SemiKitti {
+            sequence: semi_kitti::run_sequence(ctx, sequence, vocabulary.as_ref())?,
+            vocabulary_note,
+        }
+    } else {
+        UnitResult::Speed(speed::run(ctx)?)
+    };
+    Ok(serde_json::to_value(result)?)
+}
+
+/// The DBoW2-style vocabulary of the 3-D sections and its note (timed on stderr).
+fn vocabulary_3d(ctx: &EvalContext) -> Result<(Option<Arc<BinaryVocabulary>>, String)> {
+    let started = std::time::Instant::now();
+    let v = methods::kitti_vocabulary(ctx)?;
+    eprintln!(
+        "place-recognition: 3-D vocabulary in {:.0} s",
+        started.elapsed().as_secs_f64()
+    );
+    Ok(v)
+}
+
+/// The page from every unit's result.
+fn report(ctx: &EvalContext, results: &UnitResults) -> Result<super::EvalReport> {
+    page::report(ctx, stages::decode::<UnitResult>(results)?)
 }
 
 /// "k of n" rows of an aim table whose cell `column` says yes.
@@ -105,187 +239,4 @@ fn aim_row(
         });
     }
     row
-}
-
-/// Khan 2017, Table 4.2: recall at 100 % precision (%), Malaga6L and City Centre.
-const TABLE_4_2: [(&str, &str, &str); 3] = [
-    ("IBuILD", "78.13", "38.92"),
-    ("Gálvez-López (DBoW2)", "74.75", "30.61"),
-    ("FAB-MAP 2.0", "68.52", "38.77"),
-];
-
-fn thesis_table(md: &mut String) -> Result<Value> {
-    let mut t = Table::new([
-        "approach",
-        "data",
-        "Malaga6L R@100P % (thesis)",
-        "City Centre R@100P % (thesis)",
-        "ours",
-        comparable::HEADER,
-    ]);
-    for (approach, malaga, city) in TABLE_4_2 {
-        t.row([
-            approach.to_owned(),
-            "real (camera)".to_owned(),
-            malaga.to_owned(),
-            city.to_owned(),
-            "not run".to_owned(),
-            comparable::no(
-                "real camera images of Malaga 2009 parking 6L and Oxford City Centre, not \
-                 available here; none of our rows uses them (ours: lidar scans, other ground \
-                 truth)",
-            ),
-        ]);
-    }
-    writeln!(
-        md,
-        "Khan 2017, Table 4.2 (maximum recall at 100 % precision, the Gálvez-López evaluation \
-         script and hand-made loop intervals). The camera data sets (Malaga 2009 parking 6L, \
-         Oxford City Centre) are **not available here**, so our numbers above (other data, \
-         other ground truth) cannot be set beside these: not comparable.\n\n{}",
-        t.to_markdown()?
-    )?;
-    Ok(json!(
-        TABLE_4_2
-            .iter()
-            .map(|(a, m, c)| json!({ "approach": a, "malaga6l": m, "city_centre": c, "comparable": false }))
-            .collect::<Vec<_>>()
-    ))
-}
-
-/// Runs the evaluation.
-pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
-    let mut md = String::new();
-    writeln!(
-        md,
-        "Khan (2017) ch. 4: IBuILD (incremental binary bag of words, §4.4) and lidar place \
-         recognition with intensity images (§4.5), beside DBoW2-style, Scan Context, planar \
-         polar context, HOG, GIST and SHOT. Every table says whether its data are **real** or \
-         **simulated**. Seeds fixed.{}\n",
-        if ctx.quick {
-            " **Quick run**: Intel and freiburg-079 (every 16th scan) only, the 40 real KITTI \
-             frames, one short semi-synthetic stretch of sequence 00, speed at 1 000 frames."
-        } else {
-            ""
-        }
-    )?;
-    let only: Option<Vec<String>> = std::env::var("PLACE_RECOGNITION_SECTIONS")
-        .ok()
-        .map(|v| v.split(',').map(|s| s.trim().to_owned()).collect());
-    let wanted = |k: &str| only.as_ref().is_none_or(|o| o.iter().any(|x| x == k));
-    let skipped = || Section {
-        markdown: "Skipped (`PLACE_RECOGNITION_SECTIONS`).\n\n".into(),
-        json: Value::Null,
-        summary: Vec::new(),
-    };
-    writeln!(md, "## 1. Real 2-D revisits (corrected CARMEN logs)\n")?;
-    let s1 = if wanted("1") {
-        real2d::run(ctx)?
-    } else {
-        skipped()
-    };
-    md.push_str(&s1.markdown);
-    let (vocabulary, vocabulary_note) = if wanted("2") || wanted("3") {
-        let started = std::time::Instant::now();
-        let v = methods::kitti_vocabulary(ctx)?;
-        eprintln!(
-            "place-recognition: 3-D vocabulary in {:.0} s",
-            started.elapsed().as_secs_f64()
-        );
-        v
-    } else {
-        (None, String::new())
-    };
-    writeln!(
-        md,
-        "## 2. Real 3-D: 40 real KITTI frames and 5 real Ouster frames\n"
-    )?;
-    let s2 = if wanted("2") {
-        kitti_real::run(ctx, vocabulary.as_ref())?
-    } else {
-        skipped()
-    };
-    md.push_str(&s2.markdown);
-    if !vocabulary_note.is_empty() {
-        writeln!(md, "* {vocabulary_note}\n")?;
-    }
-    writeln!(md, "## 3. Semi-synthetic KITTI with real trajectories\n")?;
-    writeln!(md, "{}", super::sim::gap_note(ctx)?)?;
-    let s3 = if wanted("3") {
-        semi_kitti::run(ctx, vocabulary.as_ref())?
-    } else {
-        skipped()
-    };
-    md.push_str(&s3.markdown);
-    writeln!(md, "## 4. Speed\n")?;
-    let s4 = if wanted("4") {
-        speed::run(ctx)?
-    } else {
-        skipped()
-    };
-    md.push_str(&s4.markdown);
-    writeln!(md, "## 5. Khan Table 4.2 (camera data sets)\n")?;
-    let s5 = thesis_table(&mut md)?;
-    let summary: Vec<String> = [&s1, &s2, &s3, &s4]
-        .iter()
-        .flat_map(|s| s.summary.iter().cloned())
-        .collect();
-    let mut head = String::from("**Summary** (this run):\n\n");
-    for line in &summary {
-        head.push_str(&format!("* {line}\n"));
-    }
-    head.push('\n');
-    if let Some(at) = md.find("## 1.") {
-        md.insert_str(at, &head);
-    }
-    Ok(EvalReport {
-        name: NAME,
-        title: "Place recognition: IBuILD, lidar intensity images and baselines (Khan ch. 4)"
-            .into(),
-        markdown: md,
-        json: json!({
-            "real_2d": s1.json,
-            "real_3d": s2.json,
-            "semi_kitti": s3.json,
-            "vocabulary_3d": vocabulary_note,
-            "speed": s4.json,
-            "thesis_table_4_2": s5,
-            "summary": summary,
-        }),
-        headline: {
-            // Real sections first (3-D, then 2-D), then speed; the semi-synthetic lines stay
-            // on the page.
-            let lines: Vec<&String> = [&s2, &s1, &s4]
-                .iter()
-                .flat_map(|s| s.summary.iter())
-                .collect();
-            (!lines.is_empty()).then(|| {
-                lines
-                    .iter()
-                    .map(|l| l.trim_end_matches('.'))
-                    .collect::<Vec<_>>()
-                    .join("; ")
-                    + "."
-            })
-        },
-    })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn table_4_2_renders_and_says_why_not_comparable() {
-        let mut md = String::new();
-        let json = thesis_table(&mut md).expect("table renders");
-        assert_eq!(json.as_array().map(Vec::len), Some(TABLE_4_2.len()));
-        let rows: Vec<&str> = md.lines().filter(|l| l.starts_with("| IBuILD")).collect();
-        assert_eq!(rows.len(), 1);
-        assert!(
-            rows[0].contains("| no — real camera images of Malaga"),
-            "{}",
-            rows[0]
-        );
-    }
 }

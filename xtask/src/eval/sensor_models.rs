@@ -12,19 +12,28 @@
 //! * **simulated 2-D**: the corrected logs of the generated indoor worlds;
 //! * **simulated 3-D**: a section of the generated urban drive (HDL-64E, KITTI layout) at
 //!   0.5 m voxels, as the thesis.
+//!
+//! In stages: one unit per data set ([`measure`]) — `real/<log>` (scored at 0.1 m and again
+//! at 0.5 m for section (e), from the same scans), `indoor/<world>` and `urban-kitti` — and
+//! the page ([`report()`]) from their results alone. The indoor worlds are listed by name
+//! (quick: `office`; full: the worlds of the generated set's configuration), so listing the
+//! units generates nothing: the first unit that needs a generated set makes it.
 
 mod data;
+mod measure;
 mod report;
 
-use std::time::Instant;
+use anyhow::{Result, bail};
+use raypath_sensor_models::scoring::ScoreReport;
+use serde::{Deserialize, Serialize};
+use serde_json::{Value, json};
 
-use anyhow::{Context, Result};
-use raypath_geometry::{Pose3, Ray3};
-use raypath_sensor_models::scoring::{ScoreReport, ScoringConfig, score_log, score_spatial};
-use serde_json::json;
-
+use super::stages::{self, Staged, UnitResults};
 use super::{EvalContext, EvalReport};
-use crate::generate;
+
+const NAME: &str = "sensor-models";
+const TITLE: &str =
+    "Sensor models: likelihood at the true pose and inverse KL (Tables 7.3, 8.2, 8.3)";
 
 /// How much work a run does.
 #[derive(Clone, Copy, Debug)]
@@ -69,6 +78,10 @@ const FULL: Plan = Plan {
     max_test_scans_3d: 20,
 };
 
+fn plan(quick: bool) -> Plan {
+    if quick { QUICK } else { FULL }
+}
+
 /// 3-D cell edge (the thesis's voxels).
 const VOXEL_M: f64 = 0.5;
 /// The real 2-D logs are scored a second time at the thesis's voxel edge (section (e)).
@@ -80,7 +93,7 @@ const MAX_RANGE_3D_M: f64 = 50.0;
 const SEED: u64 = 2020;
 
 /// What kind of data a row is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Kind {
     /// A real Radish log.
     Real,
@@ -101,6 +114,7 @@ impl Kind {
 }
 
 /// The scores of one data set.
+#[derive(Serialize, Deserialize)]
 pub struct DataSet {
     /// Short name.
     pub name: String,
@@ -112,144 +126,113 @@ pub struct DataSet {
     pub report: ScoreReport,
 }
 
-/// Runs the evaluation.
-pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
-    let plan = if ctx.quick { QUICK } else { FULL };
-    let started = Instant::now();
-    let mut sets = Vec::new();
-    let mut notes = Vec::new();
+/// What one unit measured.
+#[derive(Serialize, Deserialize)]
+enum UnitResult {
+    /// The data set scored.
+    Scored(Box<Scored>),
+    /// The data set's file is absent (a world the generated set does not have).
+    Absent,
+    /// The generated data could not be made: the note for the page.
+    Unavailable(String),
+}
 
-    // Real and simulated 2-D logs.
-    let real_dir = ctx.data("carmen/corrected");
-    let mut logs: Vec<(Kind, std::path::PathBuf)> =
-        data::files_ending(&real_dir, &["-corrected.log.gz"])
+/// The scores of one data set; a real log also at [`COARSE_CELL_M`] (section (e)).
+#[derive(Serialize, Deserialize)]
+struct Scored {
+    set: DataSet,
+    coarse: Option<ScoreReport>,
+    /// Time of the unit.
+    seconds: f64,
+}
+
+/// The evaluation in stages: one unit per data set (`--shard i/n` and `eval merge`).
+pub const STAGED: Staged = Staged {
+    name: NAME,
+    units,
+    run_unit,
+    report,
+};
+
+/// The data sets in report order: the real logs (sorted), the indoor worlds (sorted), the
+/// urban drive.
+fn units(ctx: &EvalContext) -> Result<Vec<String>> {
+    let plan = plan(ctx.quick);
+    let mut units: Vec<String> = measure::real_logs(ctx, &plan)
+        .into_iter()
+        .map(|name| format!("real/{name}"))
+        .collect();
+    units.extend(
+        measure::indoor_worlds(&plan)
             .into_iter()
-            .filter(|p| {
-                plan.real_logs
-                    .is_none_or(|names| names.contains(&data::log_name(p).as_str()))
-            })
-            .map(|p| (Kind::Real, p))
-            .collect();
-    if logs.is_empty() {
+            .map(|w| format!("indoor/{w}")),
+    );
+    units.push(URBAN.into());
+    Ok(units)
+}
+
+/// The unit of the simulated urban drive.
+const URBAN: &str = "urban-kitti";
+
+/// Scores one data set.
+fn run_unit(ctx: &EvalContext, unit: &str) -> Result<Value> {
+    let plan = plan(ctx.quick);
+    let result = if let Some(name) = unit.strip_prefix("real/") {
+        measure::real_log(ctx, &plan, name)?
+    } else if let Some(world) = unit.strip_prefix("indoor/") {
+        measure::indoor_world(ctx, &plan, world)?
+    } else if unit == URBAN {
+        measure::urban(ctx, &plan)?
+    } else {
+        bail!("no unit {unit:?} in {NAME}");
+    };
+    Ok(serde_json::to_value(result)?)
+}
+
+/// The page from every data set's result.
+fn report(ctx: &EvalContext, results: &UnitResults) -> Result<EvalReport> {
+    let plan = plan(ctx.quick);
+    let units: Vec<UnitResult> = stages::decode(results)?;
+    let mut notes = Vec::new();
+    if !results.iter().any(|(unit, _)| unit.starts_with("real/")) {
         notes.push(format!(
             "No corrected CARMEN logs in `{}` (set RAYPATH_DATA): the real rows are missing.",
-            real_dir.display()
+            measure::real_dir(ctx).display()
         ));
     }
-    match generate::ensure("indoor", ctx.quick) {
-        Ok(dir) => logs.extend(
-            data::files_ending(
-                &dir,
-                &["-corrected.log", "-corrected.log.gz", "-corrected.log.bz2"],
-            )
-            .into_iter()
-            .filter(|p| {
-                plan.sim_logs
-                    .is_none_or(|names| names.contains(&data::log_name(p).as_str()))
-            })
-            .map(|p| (Kind::Sim2, p)),
-        ),
-        Err(e) => notes.push(format!("Simulated indoor worlds unavailable: {e:#}.")),
-    }
-    let config_2d = ScoringConfig {
-        seed: SEED,
-        beam_step: plan.beam_step_2d,
-        max_test_scans: plan.max_test_scans_2d,
-        ..ScoringConfig::default()
-    };
-    // The real logs once more at the thesis's cell size (section (e)).
-    let config_coarse = ScoringConfig {
-        resolution_m: COARSE_CELL_M,
-        ..config_2d
-    };
-    let mut coarse = Vec::new();
-    let bar = ctx.progress(logs.len() as u64 + 1, "2-D logs");
-    for (kind, path) in &logs {
-        let name = data::log_name(path);
-        bar.set_message(name.clone());
-        let scans =
-            data::carmen_scans(path).with_context(|| format!("reading {}", path.display()))?;
-        let report =
-            score_log(&scans, &config_2d).with_context(|| format!("scoring {}", path.display()))?;
-        if *kind == Kind::Real {
-            let report = score_log(&scans, &config_coarse)
-                .with_context(|| format!("scoring {} at {COARSE_CELL_M} m", path.display()))?;
-            coarse.push(DataSet {
-                name: name.clone(),
-                kind: *kind,
-                scans: scans.len(),
-                report,
-            });
+    let (mut sets, mut coarse, mut seconds) = (Vec::new(), Vec::new(), 0.0);
+    for unit in units {
+        match unit {
+            UnitResult::Scored(scored) => {
+                let Scored {
+                    set,
+                    coarse: at_coarse,
+                    seconds: s,
+                } = *scored;
+                if let Some(report) = at_coarse {
+                    coarse.push(DataSet {
+                        name: set.name.clone(),
+                        kind: set.kind,
+                        scans: set.scans,
+                        report,
+                    });
+                }
+                sets.push(set);
+                seconds += s;
+            }
+            UnitResult::Absent => {}
+            UnitResult::Unavailable(note) if !notes.contains(&note) => notes.push(note),
+            UnitResult::Unavailable(_) => {}
         }
-        sets.push(DataSet {
-            name,
-            kind: *kind,
-            scans: scans.len(),
-            report,
-        });
-        bar.inc(1);
     }
-    bar.finish_and_clear();
-
-    // Simulated 3-D urban drive.
-    match generate::ensure("urban-kitti", ctx.quick) {
-        Ok(dir) => {
-            let sequence = dir.join("sequences/00");
-            let bar = ctx.progress(plan.frames_3d as u64, "urban scans");
-            let scans = data::kitti_scans(
-                &sequence,
-                plan.frames_3d,
-                |frame| {
-                    if frame % 2 == 0 {
-                        plan.map_ray_step_3d
-                    } else {
-                        plan.test_ray_step_3d
-                    }
-                },
-                || bar.inc(1),
-            )
-            .with_context(|| format!("reading {}", sequence.display()))?;
-            bar.finish_and_clear();
-            let map: Vec<(Pose3, &[Ray3])> = scans
-                .iter()
-                .step_by(2)
-                .map(|s| (s.pose, s.rays.as_slice()))
-                .collect();
-            let test: Vec<(Pose3, &[Ray3])> = scans
-                .iter()
-                .skip(1)
-                .step_by(2)
-                .map(|s| (s.pose, s.rays.as_slice()))
-                .collect();
-            let config_3d = ScoringConfig {
-                resolution_m: VOXEL_M,
-                max_range_m: Some(MAX_RANGE_3D_M),
-                seed: SEED,
-                beam_step: 1,
-                max_test_scans: Some(plan.max_test_scans_3d),
-                ..ScoringConfig::default()
-            };
-            let spinner = ctx.progress(1, "urban scoring");
-            let report = score_spatial(&map, &test, &config_3d).context("scoring urban-kitti")?;
-            spinner.finish_and_clear();
-            sets.push(DataSet {
-                name: "urban-kitti".into(),
-                kind: Kind::Sim3,
-                scans: scans.len(),
-                report,
-            });
-        }
-        Err(e) => notes.push(format!("Simulated urban drive unavailable: {e:#}.")),
-    }
-
-    let seconds = started.elapsed().as_secs_f64();
-    let mut markdown = report::markdown(&sets, &plan_text(&plan, ctx.quick), &notes)?;
+    let plan_text = plan_text(&plan, ctx.quick);
+    let mut markdown = report::markdown(&sets, &plan_text, &notes)?;
     markdown.push_str(&report::coarse_section(&coarse, COARSE_CELL_M)?);
     let json = json!({
         "quick": ctx.quick,
         "seed": SEED,
         "seconds": seconds,
-        "plan": plan_text(&plan, ctx.quick),
+        "plan": plan_text,
         "notes": notes,
         "data_sets": sets.iter().map(|s| json!({
             "name": s.name,
@@ -269,9 +252,8 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
         },
     });
     Ok(EvalReport {
-        name: "sensor-models",
-        title: "Sensor models: likelihood at the true pose and inverse KL (Tables 7.3, 8.2, 8.3)"
-            .to_owned(),
+        name: NAME,
+        title: TITLE.to_owned(),
         markdown,
         json,
         headline: None,
@@ -309,5 +291,95 @@ fn every(k: usize, noun: &str) -> String {
         2 => format!("every 2nd {noun}"),
         3 => format!("every 3rd {noun}"),
         k => format!("every {k}th {noun}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scored(name: &str, kind: Kind, coarse: bool) -> (String, Value) {
+        let set = report::tests::data_set(name, kind);
+        let coarse = coarse.then(|| set.report.clone());
+        let unit = match kind {
+            Kind::Real => format!("real/{name}"),
+            Kind::Sim2 => format!("indoor/{name}"),
+            Kind::Sim3 => URBAN.to_owned(),
+        };
+        let result = UnitResult::Scored(Box::new(Scored {
+            set,
+            coarse,
+            seconds: 2.5,
+        }));
+        (unit, serde_json::to_value(result).unwrap())
+    }
+
+    /// The page from known units: data sets in unit order, the real log also at 0.5 m, an
+    /// absent world left out, the note of an unavailable set once, the JSON keys of a whole
+    /// run.
+    #[test]
+    fn report_from_known_units() {
+        let dir = tempfile::tempdir().unwrap();
+        let ctx = EvalContext::scratch(dir.path());
+        let unavailable = UnitResult::Unavailable("Simulated indoor worlds unavailable: x.".into());
+        let results = vec![
+            scored("intel", Kind::Real, true),
+            (
+                "indoor/hall".to_owned(),
+                serde_json::to_value(UnitResult::Absent).unwrap(),
+            ),
+            (
+                "indoor/lab".to_owned(),
+                serde_json::to_value(&unavailable).unwrap(),
+            ),
+            (
+                "indoor/office".to_owned(),
+                serde_json::to_value(&unavailable).unwrap(),
+            ),
+            scored("urban-kitti", Kind::Sim3, false),
+        ];
+        let page = report(&ctx, &results).unwrap();
+        let md = &page.markdown;
+        assert!(md.contains("**Workload.** Quick run."), "{md}");
+        assert_eq!(
+            md.matches("*Note:* Simulated indoor worlds unavailable: x.")
+                .count(),
+            1,
+            "{md}"
+        );
+        assert!(!md.contains("No corrected CARMEN logs"));
+        assert!(md.lines().any(|l| l.starts_with("| intel ")));
+        assert!(md.lines().any(|l| l.starts_with("| urban-kitti ")));
+        let mut keys: Vec<&String> = page.json.as_object().unwrap().keys().collect();
+        keys.sort();
+        assert_eq!(
+            keys,
+            [
+                "agreement",
+                "data_sets",
+                "notes",
+                "plan",
+                "quick",
+                "real_2d_at_0_5_m",
+                "seconds",
+                "seed"
+            ]
+        );
+        let sets = page.json["data_sets"].as_array().unwrap();
+        assert_eq!(sets.len(), 2);
+        assert_eq!(sets[0]["name"], "intel");
+        assert_eq!(sets[1]["kind"], "simulated 3-D");
+        assert_eq!(page.json["seconds"], 5.0);
+        let coarse = &page.json["real_2d_at_0_5_m"];
+        assert_eq!(coarse["data_sets"].as_array().unwrap().len(), 1);
+        assert_eq!(coarse["cell_m"], COARSE_CELL_M);
+
+        let without_real = report(&ctx, &results[1..]).unwrap();
+        assert!(
+            without_real.json["notes"][0]
+                .as_str()
+                .unwrap()
+                .starts_with("No corrected CARMEN logs in")
+        );
     }
 }

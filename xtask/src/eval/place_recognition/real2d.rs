@@ -1,23 +1,34 @@
 //! Section 1: real 2-D revisits on the corrected CARMEN logs (real scans, real SLAM-corrected
 //! poses as ground truth): IBuILD and DBoW2-style on rasterised scans, planar polar context;
 //! online loop closure and kidnapped mode.
+//!
+//! In stages: one unit per fold of the vocabulary training ([`run_fold`]: the fold's
+//! DBoW2-style vocabulary, trained once on the other fold's logs, then each of its logs), the
+//! section ([`page::section`]) from both folds' results. The fold and not the log is the unit
+//! because its logs share the vocabulary: per-log units would train it once per log (five times
+//! per fold in a full run).
 
-use std::fmt::Write;
+mod page;
+
+use std::path::Path;
 use std::sync::Arc;
 
-use anyhow::Result;
+use anyhow::{Result, ensure};
 use rayon::prelude::*;
 use raypath_place_recognition::{BinaryVocabulary, Frame};
+use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 
 use super::data2d::{LOGS, Log2, load};
-use super::methods;
-use super::report::{SWEEP_HEADERS, is_sweep, pr_figures, result_cells, results_table, sweep_rows};
+use super::report::{is_sweep, pr_figures, result_cells, sweep_rows};
 use super::runner::{Features, Input, MethodResult, Sample};
-use super::truth;
-use super::{FIGURES, Section};
+use super::{FIGURES, aim_row, methods, truth};
 use crate::eval::EvalContext;
-use crate::table::Table;
+
+pub use page::section;
+
+/// The folds (units of the section).
+pub const FOLD_COUNT: usize = FOLDS.len();
 
 /// Scans rasterised and described at once (in parallel) before they are fed to the methods.
 const CHUNK: usize = 16;
@@ -61,61 +72,57 @@ fn plan(quick: bool) -> Vec<(&'static str, &'static str, Option<usize>)> {
         .collect()
 }
 
-/// Trains the vocabulary of each fold on the other fold's logs.
-fn vocabularies(
-    ctx: &EvalContext,
-    notes: &mut Vec<String>,
-) -> Result<[Option<Arc<BinaryVocabulary>>; 2]> {
+/// Trains the vocabulary of `fold`'s logs on the other fold's logs; returns it (`None` when
+/// no training log is found) with the note for the report.
+fn vocabulary(ctx: &EvalContext, fold: usize) -> Result<(Option<Arc<BinaryVocabulary>>, String)> {
     let per_log = if ctx.quick {
         TRAIN_IMAGES_QUICK
     } else {
         TRAIN_IMAGES
     };
-    let mut out = [None, None];
-    for (fold, slot) in out.iter_mut().enumerate() {
-        let train: Vec<&str> = if ctx.quick {
-            FOLDS_QUICK[1 - fold].to_vec()
-        } else {
-            FOLDS[1 - fold].to_vec()
+    let train: Vec<&str> = if ctx.quick {
+        FOLDS_QUICK[1 - fold].to_vec()
+    } else {
+        FOLDS[1 - fold].to_vec()
+    };
+    let mut images = Vec::new();
+    let mut used = Vec::new();
+    for name in &train {
+        let Some((_, path)) = LOGS.iter().find(|(n, _)| n == name) else {
+            continue;
         };
-        let mut images = Vec::new();
-        let mut used = Vec::new();
-        for name in &train {
-            let Some((_, path)) = LOGS.iter().find(|(n, _)| n == name) else {
-                continue;
-            };
-            let file = ctx.data(path);
-            if !file.exists() {
-                continue;
-            }
-            let log = load(&file, 1)?;
-            let step = log.scans.len().div_ceil(per_log).max(1);
-            let scans: Vec<_> = log.scans.iter().step_by(step).collect();
-            let described: Vec<Vec<_>> = scans
-                .par_iter()
-                .map(|s| Ok(methods::planar_features(s)?.descriptors))
-                .collect::<Result<_>>()?;
-            used.push(format!("{name} ({} scans)", described.len()));
-            images.extend(described);
-        }
-        if images.is_empty() {
-            notes.push(format!(
-                "No training log of fold {} found: no DBoW2-style vocabulary.",
-                1 - fold
-            ));
+        let file = ctx.data(path);
+        if !file.exists() {
             continue;
         }
-        let descriptors: usize = images.iter().map(Vec::len).sum();
-        let vocabulary = methods::train_vocabulary(&images)?;
-        notes.push(format!(
-            "Vocabulary for the logs {{{}}}: trained on {} — {descriptors} descriptors, {} words.",
-            FOLDS[fold].join(", "),
-            used.join(", "),
-            vocabulary.word_count()
-        ));
-        *slot = Some(vocabulary);
+        let log = load(&file, 1)?;
+        let step = log.scans.len().div_ceil(per_log).max(1);
+        let scans: Vec<_> = log.scans.iter().step_by(step).collect();
+        let described: Vec<Vec<_>> = scans
+            .par_iter()
+            .map(|s| Ok(methods::planar_features(s)?.descriptors))
+            .collect::<Result<_>>()?;
+        used.push(format!("{name} ({} scans)", described.len()));
+        images.extend(described);
     }
-    Ok(out)
+    if images.is_empty() {
+        return Ok((
+            None,
+            format!(
+                "No training log of fold {} found: no DBoW2-style vocabulary.",
+                1 - fold
+            ),
+        ));
+    }
+    let descriptors: usize = images.iter().map(Vec::len).sum();
+    let vocabulary = methods::train_vocabulary(&images)?;
+    let note = format!(
+        "Vocabulary for the logs {{{}}}: trained on {} — {descriptors} descriptors, {} words.",
+        FOLDS[fold].join(", "),
+        used.join(", "),
+        vocabulary.word_count()
+    );
+    Ok((Some(vocabulary), note))
 }
 
 /// Runs every method on one log.
@@ -148,85 +155,143 @@ fn evaluate_log(
     Ok((results, truth))
 }
 
-/// Runs the section.
-pub fn run(ctx: &EvalContext) -> Result<Section> {
-    let mut md = String::new();
-    let mut notes = Vec::new();
-    let vocabularies = vocabularies(ctx, &mut notes)?;
+/// What one fold's unit measured: the note on its vocabulary and its logs in plan order.
+#[derive(Serialize, Deserialize)]
+pub struct FoldResult {
+    /// How the fold's DBoW2-style vocabulary was trained (or why there is none).
+    pub vocabulary_note: String,
+    /// The logs of the fold in this run.
+    pub logs: Vec<LogOutcome>,
+}
+
+/// One log of a fold: its rows, or the note that it is missing.
+#[derive(Serialize, Deserialize)]
+pub enum LogOutcome {
+    /// The log ran.
+    Done(Box<LogRows>),
+    /// The log's file is absent.
+    Missing {
+        /// The log.
+        name: String,
+        /// Its path under the data directory.
+        path: String,
+    },
+}
+
+impl LogOutcome {
+    /// The log's name.
+    pub fn name(&self) -> &str {
+        match self {
+            LogOutcome::Done(rows) => &rows.name,
+            LogOutcome::Missing { name, .. } => name,
+        }
+    }
+}
+
+/// The table rows, pictures and JSON of one log (the cells as the page prints them).
+#[derive(Serialize, Deserialize)]
+pub struct LogRows {
+    /// The log.
+    pub name: String,
+    /// Rows of the results table (one per method, the δ sweep left out).
+    pub results: Vec<Vec<String>>,
+    /// Rows of the δ-sweep table.
+    pub sweep: Vec<Vec<String>>,
+    /// The aim row (IBuILD against DBoW2-style).
+    pub aim: Vec<String>,
+    /// The same for the symmetric IBuILD (shown, not counted in the summary).
+    pub symmetric_aim: Vec<String>,
+    /// The PR pictures (markdown; the PNGs are written by the unit).
+    pub pictures: String,
+    /// The log's figures for the JSON.
+    pub json: Value,
+}
+
+/// The position of each log of this run in the report (the order of [`LOGS`]).
+pub fn log_order(quick: bool) -> Vec<&'static str> {
+    plan(quick).into_iter().map(|(name, _, _)| name).collect()
+}
+
+/// The unit of fold `fold`: its vocabulary, then every log of the fold in this run.
+pub fn run_fold(ctx: &EvalContext, fold: usize) -> Result<FoldResult> {
+    ensure!(fold < FOLD_COUNT, "no fold {fold}");
+    let (vocabulary, vocabulary_note) = vocabulary(ctx, fold)?;
     let figures = ctx.figure_dir(FIGURES)?;
-    let mut table = results_table(&["log", "data", "scans", "revisit queries", "true pairs"]);
-    let mut aims = Table::new([
-        "log",
-        "data",
-        "IBuILD online R@100P %",
-        "DBoW2-style online R@100P %",
-        "holds online",
-        "IBuILD kidnapped R@100P %",
-        "DBoW2-style kidnapped R@100P %",
-        "holds kidnapped",
-    ]);
-    let mut sweep = Table::new(["log", "data"].into_iter().chain(SWEEP_HEADERS));
-    let mut aim_rows = Vec::new();
-    // Our symmetric-score IBuILD beside the same baseline (shown, not counted in the summary).
-    let mut sym_aim_rows = Vec::new();
-    let mut json_logs = Vec::new();
-    let mut pictures = String::new();
+    let mut logs = Vec::new();
     for (name, path, stride) in plan(ctx.quick) {
-        let file = ctx.data(path);
-        if !file.exists() {
-            notes.push(format!("`{path}` missing: {name} skipped."));
+        if fold_of(name) != fold {
             continue;
         }
-        let started = std::time::Instant::now();
-        let full = load(&file, 1)?;
-        let total = full.scans.len();
-        let stride = stride.unwrap_or_else(|| total.div_ceil(MAX_SCANS).max(1));
-        let log = full.subsample(stride);
-        let (results, truth) = evaluate_log(&log, vocabularies[fold_of(name)].as_ref())?;
-        let queries = truth::revisit_queries(&truth);
-        let scans = if stride > 1 {
-            format!("{} (every {stride}th of {total})", log.scans.len())
-        } else {
-            log.scans.len().to_string()
-        };
-        for row in sweep_rows(&[name.to_string(), "real".into()], &results, Input::Planar) {
-            sweep.row(row);
+        let file = ctx.data(path);
+        if !file.exists() {
+            logs.push(LogOutcome::Missing {
+                name: name.to_owned(),
+                path: path.to_owned(),
+            });
+            continue;
         }
-        for r in results.iter().filter(|r| !is_sweep(r)) {
-            table.row(
-                [
-                    name.to_string(),
-                    "real".into(),
-                    scans.clone(),
-                    queries.to_string(),
-                    truth.true_pairs().to_string(),
-                ]
-                .into_iter()
-                .chain(result_cells(r)),
-            );
-        }
-        aim_rows.push(super::aim_row(
+        let rows = run_log(&file, name, stride, vocabulary.as_ref(), &figures)?;
+        logs.push(LogOutcome::Done(Box::new(rows)));
+    }
+    Ok(FoldResult {
+        vocabulary_note,
+        logs,
+    })
+}
+
+/// Every method on one log (every `stride`-th scan; `None`: at most [`MAX_SCANS`]): its rows,
+/// PR pictures (written to `figures`) and JSON.
+fn run_log(
+    file: &Path,
+    name: &str,
+    stride: Option<usize>,
+    vocabulary: Option<&Arc<BinaryVocabulary>>,
+    figures: &Path,
+) -> Result<LogRows> {
+    let started = std::time::Instant::now();
+    let full = load(file, 1)?;
+    let total = full.scans.len();
+    let stride = stride.unwrap_or_else(|| total.div_ceil(MAX_SCANS).max(1));
+    let log = full.subsample(stride);
+    let (results, truth) = evaluate_log(&log, vocabulary)?;
+    let queries = truth::revisit_queries(&truth);
+    let scans = if stride > 1 {
+        format!("{} (every {stride}th of {total})", log.scans.len())
+    } else {
+        log.scans.len().to_string()
+    };
+    let leading = [
+        name.to_string(),
+        "real".into(),
+        scans,
+        queries.to_string(),
+        truth.true_pairs().to_string(),
+    ];
+    let rows = LogRows {
+        name: name.to_owned(),
+        results: results
+            .iter()
+            .filter(|r| !is_sweep(r))
+            .map(|r| leading.iter().cloned().chain(result_cells(r)).collect())
+            .collect(),
+        sweep: sweep_rows(&[name.to_string(), "real".into()], &results, Input::Planar),
+        aim: aim_row(
             name,
             "real",
             &results,
             "IBuILD (rasterised scan)",
             "DBoW2-style (rasterised scan)",
-        ));
-        sym_aim_rows.push(super::aim_row(
+        ),
+        symmetric_aim: aim_row(
             &format!("{name} ({})", methods::SYMMETRIC_IBUILD),
             "real",
             &results,
             &format!("{} (rasterised scan)", methods::SYMMETRIC_IBUILD),
             "DBoW2-style (rasterised scan)",
-        ));
-        pictures.push_str(&format!("**{name}**\n\n"));
-        pictures.push_str(&pr_figures(
-            &figures,
-            FIGURES,
-            &format!("2d-{name}"),
-            &results,
-        )?);
-        json_logs.push(json!({
+        ),
+        pictures: format!("**{name}**\n\n")
+            + &pr_figures(figures, FIGURES, &format!("2d-{name}"), &results)?,
+        json: json!({
             "log": name,
             "data": "real",
             "scans": log.scans.len(),
@@ -235,74 +300,12 @@ pub fn run(ctx: &EvalContext) -> Result<Section> {
             "revisit_queries": queries,
             "true_pairs": truth.true_pairs(),
             "methods": results.iter().map(MethodResult::json).collect::<Vec<Value>>(),
-        }));
-        eprintln!(
-            "place-recognition: 2-D {name} done in {:.0} s ({} scans)",
-            started.elapsed().as_secs_f64(),
-            log.scans.len()
-        );
-    }
-    writeln!(
-        md,
-        "DBoW2-style vocabularies (k = 10, L = 6) are trained offline with two folds: the logs \
-         {{{}}} are evaluated with the vocabulary trained on {{{}}} and vice versa, so no log is \
-         ever described by a vocabulary that saw it ({} evenly spaced scans per training log; \
-         list below). IBuILD needs no training (its vocabulary grows online). Both read the \
-         same rasterised scans (0.1 m pixels over ±15 m; ours) and FAST/BRIEF-512 features; \
-         the polar context reads the end points.\n",
-        FOLDS[0].join(", "),
-        FOLDS[1].join(", "),
-        if ctx.quick {
-            TRAIN_IMAGES_QUICK
-        } else {
-            TRAIN_IMAGES
-        }
-    )?;
-    writeln!(
-        md,
-        "Ground truth: {}. Online: each scan queries the scans outside the exclusion window, then \
-         is inserted; loops accepted with the temporal-consistency test (β = 10, Khan 2017, \
-         §4.4.3), the threshold on the best candidate's score swept for the curve. Kidnapped: \
-         every scan against the whole database (similarity matrix, §4.5.3), each unordered \
-         pair once. R@100P = recall at 100 % precision, P@100R = precision at 100 % recall. \
-         ms/query = describe + query + insert of the online run (the methods ran two at a time \
-         on a shared 2-core machine).\n",
-        truth::rule_2d()
-    )?;
-    writeln!(md, "{}", table.to_markdown()?)?;
-    for row in aim_rows.iter().chain(&sym_aim_rows) {
-        aims.row(row.clone());
-    }
-    writeln!(
-        md,
-        "**Aim: IBuILD recall at 100 % precision ≥ the DBoW2-style baseline**, per log:\n\n{}",
-        aims.to_markdown()?
-    )?;
-    writeln!(
-        md,
-        "**IBuILD δ sweep.** The thesis traces its precision–recall points by varying the \
-         matching threshold δ, one point per δ with no score threshold (Khan 2017, §4.6.1; the \
-         values are not printed). The thesis-style point of each δ = every loop the \
-         temporal-consistency test accepts; the other columns sweep the score threshold as \
-         above. δ = {} is the default used in the tables above (chosen before seeing these \
-         numbers; picking the best δ afterwards would tune on the test data).\n\n{}",
-        methods::DEFAULT_DELTA,
-        sweep.to_markdown()?
-    )?;
-    writeln!(md, "{pictures}")?;
-    for n in &notes {
-        writeln!(md, "* {n}")?;
-    }
-    writeln!(md)?;
-    let summary = vec![format!(
-        "Real 2-D (CARMEN): IBuILD recall at 100 % precision ≥ DBoW2-style on {} logs online \
-         and {} kidnapped.",
-        super::count_yes(&aim_rows, 4),
-        super::count_yes(&aim_rows, 7)
-    )];
-    Ok(Section {
-        summary,
-        markdown: md,
-        json: json!({ "logs": json_logs, "notes": notes }),
-    })
+        }),
+    };
+    eprintln!(
+        "place-recognition: 2-D {name} done in {:.0} s ({} scans)",
+        started.elapsed().as_secs_f64(),
+        log.scans.len()
+    );
+    Ok(rows)
 }

@@ -578,10 +578,11 @@ pub fn coarse_section(sets: &[DataSet], cell_m: f64) -> Result<String> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
-    fn data_set(name: &str, kind: Kind) -> DataSet {
+    /// A data set with every model of the tables (the report stage's tests build on it).
+    pub(in crate::eval::sensor_models) fn data_set(name: &str, kind: Kind) -> DataSet {
         let rows = COLUMNS
             .iter()
             .enumerate()
