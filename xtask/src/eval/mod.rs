@@ -278,8 +278,13 @@ fn staged(name: &str) -> Result<&'static stages::Staged> {
         .find(|s| s.name == name)
         .with_context(|| {
             let names: Vec<_> = staged_evaluations().map(|s| s.name).collect();
+            let what = if EVALUATIONS.iter().any(|(n, _, _)| *n == name) {
+                "runs whole (not in stages)"
+            } else {
+                "is no evaluation"
+            };
             format!(
-                "{name:?} is not (yet) written in stages; --shard and merge work for: {}",
+                "{name:?} {what}; --shard and merge work for: {}",
                 names.join(", ")
             )
         })
