@@ -3,8 +3,9 @@
 #![allow(missing_docs, clippy::unwrap_used)]
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use nalgebra::Point3;
-use raypath_rtree_grid::{FusionRule, GridConfig, RtreeGrid, SensorModel};
+use nalgebra::{Point3, UnitQuaternion};
+use raypath_geometry::{PointCloud, Pose3};
+use raypath_rtree_grid::{FusionRule, GridConfig, RtreeGrid, Selection, SensorModel};
 
 fn room_scan(n: usize) -> Vec<Point3<f64>> {
     (0..n)
@@ -82,6 +83,54 @@ fn bench_street(c: &mut Criterion) {
                 for (origin, scan) in &street {
                     grid.insert_scan(origin, scan);
                 }
+                grid.num_leaves()
+            })
+        },
+    );
+    // Fusion from every updated cell, after each scan and once after the five.
+    for interval in [1u32, 5] {
+        group.bench_function(
+            format!(
+                "insert 5 street scans (EqualValue, every updated cell, fused every {interval} scans)"
+            ),
+            |b| {
+                b.iter(|| {
+                    let mut config = GridConfig::with(0.2, 8, SensorModel::BeamBased);
+                    config.fusion_rule = FusionRule::EqualValue;
+                    config.selection = Selection::UpdatedCells;
+                    config.fusion_interval_scans = interval;
+                    let mut grid = RtreeGrid::new(config).unwrap();
+                    for (origin, scan) in &street {
+                        grid.insert_scan(origin, scan);
+                    }
+                    grid.fuse_pending();
+                    grid.num_leaves()
+                })
+            },
+        );
+    }
+    // The same five scans as one batch (cells enter the tree only after the fusion pass).
+    let clouds: Vec<(Pose3, PointCloud)> = street
+        .iter()
+        .map(|(origin, scan)| {
+            let local = scan
+                .iter()
+                .map(|p| (p - origin).cast::<f32>().into())
+                .collect();
+            let pose = Pose3::from_parts(origin.coords, UnitQuaternion::identity());
+            (pose, PointCloud::from_points(local))
+        })
+        .collect();
+    group.bench_function(
+        "insert 5 street scans as one batch (EqualValue, every updated cell, fused every 5 scans)",
+        |b| {
+            b.iter(|| {
+                let mut config = GridConfig::with(0.2, 8, SensorModel::BeamBased);
+                config.fusion_rule = FusionRule::EqualValue;
+                config.selection = Selection::UpdatedCells;
+                config.fusion_interval_scans = 5;
+                let mut grid = RtreeGrid::new(config).unwrap();
+                grid.insert_clouds(clouds.iter().map(|(p, c)| (p, c)));
                 grid.num_leaves()
             })
         },

@@ -32,7 +32,9 @@ fn leaf_digest(grid: &RtreeGrid) -> u64 {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let Some(path) = args.get(1) else {
-        eprintln!("usage: profile <scans.graph> [resolution_m] [label filter]");
+        eprintln!(
+            "usage: profile <scans.graph> [resolution_m] [label filter] [max scans] [fusion interval] [batch]"
+        );
         std::process::exit(2);
     };
     let graph = match raypath_io::octomap::read_graph(std::path::Path::new(path)) {
@@ -46,6 +48,7 @@ fn main() {
     let only: Option<&str> = args.get(3).map(String::as_str);
     let max_scans: usize = args.get(4).map_or(usize::MAX, |s| s.parse().unwrap());
     let interval: u32 = args.get(5).map_or(1, |s| s.parse().unwrap());
+    let batch = args.get(6).is_some_and(|s| s == "batch");
     for (label, fusion, model, rule, selection) in [
         (
             "beam, clamped",
@@ -108,12 +111,19 @@ fn main() {
         let t = Instant::now();
         let mut keys = 0;
         let mut splits = 0;
-        for n in graph.nodes.iter().take(max_scans) {
-            let u = grid.insert_cloud(&n.world_from_sensor, &n.points);
+        if batch {
+            let scans = graph.nodes.iter().take(max_scans);
+            let u = grid.insert_clouds(scans.map(|n| (&n.world_from_sensor, &n.points)));
             keys += u.free_keys + u.occupied_keys;
             splits += u.splits;
+        } else {
+            for n in graph.nodes.iter().take(max_scans) {
+                let u = grid.insert_cloud(&n.world_from_sensor, &n.points);
+                keys += u.free_keys + u.occupied_keys;
+                splits += u.splits;
+            }
+            grid.fuse_pending();
         }
-        grid.fuse_pending();
         let secs = t.elapsed().as_secs_f64();
         let working_bytes = grid.memory_bytes();
         grid.shrink_to_fit();

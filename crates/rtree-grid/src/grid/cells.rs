@@ -103,6 +103,7 @@ impl RtreeGrid {
             None => self.tree.item_slots() as u32,
         };
         self.tree.store_item(id, bx, log_odds.to_bits());
+        self.settled.unmark(id);
         self.pending.set(id);
         self.pending.created.push(id);
         let tree = &self.tree;

@@ -50,16 +50,66 @@ fn slab(bx: &KeyBox, (axis, positive): Direction) -> Option<KeyBox> {
     Some(s)
 }
 
+/// The cells of one fusion pass that no slab can join: within a pass a slab that failed
+/// keeps failing (unknown cubes stay unknown, values stay, and fusion only makes the cells
+/// reaching into it larger), so a later seed in such a cell would repeat the same six failed
+/// slab walks. A bit per cell id; an id freed and reused within the pass loses its bit.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Settled {
+    bits: Vec<u64>,
+    ids: Vec<u32>,
+}
+
+impl Settled {
+    fn mark(&mut self, id: u32) {
+        let word = id as usize / 64;
+        if word >= self.bits.len() {
+            self.bits.resize(word + 1, 0);
+        }
+        self.bits[word] |= 1 << (id % 64);
+        self.ids.push(id);
+    }
+
+    fn contains(&self, id: u32) -> bool {
+        self.bits
+            .get(id as usize / 64)
+            .is_some_and(|w| w & (1 << (id % 64)) != 0)
+    }
+
+    /// Forgets `id` (a new cell took it).
+    #[inline]
+    pub(super) fn unmark(&mut self, id: u32) {
+        if let Some(w) = self.bits.get_mut(id as usize / 64) {
+            *w &= !(1 << (id % 64));
+        }
+    }
+
+    /// Forgets every cell (the end of a pass).
+    pub(super) fn clear(&mut self) {
+        for &id in &self.ids {
+            if let Some(w) = self.bits.get_mut(id as usize / 64) {
+                *w = 0;
+            }
+        }
+        self.ids.clear();
+    }
+}
+
 impl RtreeGrid {
     /// Runs `Fuse(g_i)` on cell `id` (repeating on the fused cell, the thesis' recursive
-    /// call); returns the number of fusion steps.
+    /// call); returns the number of fusion steps. A cell settled earlier in the pass is
+    /// skipped (the result is the same).
     pub(super) fn fuse(&mut self, mut id: u32) -> usize {
+        if self.settled.contains(id) {
+            return 0;
+        }
         let mut steps = 0;
         let mut members = std::mem::take(&mut self.members);
         while let Some(next) = self.fuse_step(id, &mut members) {
             id = next;
             steps += 1;
         }
+        self.settled.mark(id);
         self.members = members;
         steps
     }

@@ -105,7 +105,29 @@ pub struct RtreeGrid {
     /// Fusion scratch: the seeds with their Morton codes, and a slab's member cells.
     seed_order: Vec<(u64, u64, KeyBox)>,
     members: Vec<u32>,
+    /// Cells of the running fusion pass that cannot grow.
+    settled: fuse::Settled,
     recent: ray::RecentKeys,
+}
+
+/// The valid points of `cloud` in the world frame.
+fn world_points(world_from_sensor: &Pose3, cloud: &PointCloud) -> Vec<Point3<f64>> {
+    (0..cloud.len())
+        .filter(|&i| cloud.is_valid(i))
+        .map(|i| world_from_sensor.transform_point(&cloud.point_f64(i)))
+        .collect()
+}
+
+impl std::ops::AddAssign for ScanUpdate {
+    fn add_assign(&mut self, other: Self) {
+        self.beams += other.beams;
+        self.off_lattice += other.off_lattice;
+        self.free_keys += other.free_keys;
+        self.occupied_keys += other.occupied_keys;
+        self.created += other.created;
+        self.fusions += other.fusions;
+        self.splits += other.splits;
+    }
 }
 
 /// Keys looked up ahead of their updates in a scan.
@@ -173,6 +195,7 @@ impl RtreeGrid {
             recent: ray::RecentKeys::new(),
             seed_order: Vec::new(),
             members: Vec::new(),
+            settled: fuse::Settled::default(),
         })
     }
 
@@ -227,17 +250,44 @@ impl RtreeGrid {
     /// Inserts one scan of a sensor at `world_from_sensor` with points in the sensor frame;
     /// invalid (NaN) points are skipped.
     pub fn insert_cloud(&mut self, world_from_sensor: &Pose3, cloud: &PointCloud) -> ScanUpdate {
-        let origin = world_from_sensor.translation();
-        let points: Vec<Point3<f64>> = (0..cloud.len())
-            .filter(|&i| cloud.is_valid(i))
-            .map(|i| world_from_sensor.transform_point(&cloud.point_f64(i)))
-            .collect();
-        self.insert_scan(&Point3::from(origin), &points)
+        let origin = Point3::from(world_from_sensor.translation());
+        self.insert_scan(&origin, &world_points(world_from_sensor, cloud))
+    }
+
+    /// Inserts scans one after the other (sensor pose, points in the sensor frame; invalid
+    /// points skipped), fusing when [`GridConfig::fusion_interval_scans`] says so and once more
+    /// after the last: the leaves are those of [`Self::insert_cloud`] per scan followed by
+    /// [`Self::fuse_pending`]. Faster with a fusion interval above one scan: the cells of the
+    /// scans between two fusion passes enter the R-tree only after the pass, so the cells it
+    /// fuses never do. Returns the counters summed over the scans.
+    pub fn insert_clouds<'a>(
+        &mut self,
+        scans: impl IntoIterator<Item = (&'a Pose3, &'a PointCloud)>,
+    ) -> ScanUpdate {
+        let mut total = ScanUpdate::default();
+        for (world_from_sensor, cloud) in scans {
+            let origin = Point3::from(world_from_sensor.translation());
+            let points = world_points(world_from_sensor, cloud);
+            total += self.insert_scan_with(&origin, &points, false);
+        }
+        total.fusions += self.fuse_pending();
+        total
     }
 
     /// Inserts one scan: beams from `origin_m` to each end point (world frame, metres).
     /// Updates every touched cell once (occupied wins over free), then fuses (§2.5.3).
     pub fn insert_scan(&mut self, origin_m: &Point3<f64>, points_m: &[Point3<f64>]) -> ScanUpdate {
+        self.insert_scan_with(origin_m, points_m, true)
+    }
+
+    /// [`Self::insert_scan`]; without `commit`, the new cells enter the R-tree only when a
+    /// fusion pass runs (the caller fuses at the end).
+    fn insert_scan_with(
+        &mut self,
+        origin_m: &Point3<f64>,
+        points_m: &[Point3<f64>],
+        commit: bool,
+    ) -> ScanUpdate {
         let mut update = ScanUpdate::default();
         let mut free_keys = std::mem::take(&mut self.free_keys);
         let mut occupied_keys = std::mem::take(&mut self.occupied_keys);
@@ -258,10 +308,13 @@ impl RtreeGrid {
         self.scans += 1;
         self.selected = selected;
         let interval = u64::from(self.config.fusion_interval_scans);
-        if self.config.fusion && self.scans % interval == 0 {
+        let fuse = self.config.fusion && self.scans % interval == 0;
+        if fuse {
             update.fusions += self.fuse_seeds();
         }
-        self.commit();
+        if fuse || commit {
+            self.commit();
+        }
         if self.free_cells.len() > 4096 && self.free_cells.len() * 2 > self.tree.item_slots() {
             self.compact();
         }
@@ -352,6 +405,7 @@ impl RtreeGrid {
             }
         }
         self.seed_order = order;
+        self.settled.clear();
         steps
     }
 
@@ -507,5 +561,6 @@ impl RtreeGrid {
         self.touched_exact = Vec::new();
         self.seed_order = Vec::new();
         self.members = Vec::new();
+        self.settled = fuse::Settled::default();
     }
 }

@@ -434,3 +434,47 @@ fn equal_value_fuses_unclamped_free_space_of_one_scan() {
     assert!(splits > 0);
     assert_matches_plain(&grid, &reference, 0.0);
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(16))]
+
+    /// Inserting a batch of scans (cells enter the R-tree only after each fusion pass) gives
+    /// the leaves of per-scan insertion followed by `fuse_pending`, with a valid tree.
+    #[test]
+    fn batch_insertion_gives_the_leaves_of_per_scan_insertion(
+        seed in any::<u64>(),
+        equal in any::<bool>(),
+        updated in any::<bool>(),
+        scans in 1usize..6,
+        interval in 1u32..4,
+    ) {
+        let data = moving_scans(seed, scans, 250);
+        let mut config = GridConfig::with(0.25, 8, SensorModel::BeamBased);
+        config.fusion_interval_scans = interval;
+        if updated {
+            config.selection = Selection::UpdatedCells;
+        }
+        if equal {
+            config.fusion_rule = FusionRule::EqualValue;
+        }
+        // The same scans as sensor-frame clouds at translated poses.
+        let clouds: Vec<(Pose3, PointCloud)> = data
+            .iter()
+            .map(|(origin, points)| {
+                let local = points.iter().map(|p| (p - origin).cast::<f32>().into()).collect();
+                (Pose3::from_parts(origin.coords, nalgebra::UnitQuaternion::identity()),
+                    PointCloud::from_points(local))
+            })
+            .collect();
+        let mut per_scan = RtreeGrid::new(config).unwrap();
+        for (pose, cloud) in &clouds {
+            per_scan.insert_cloud(pose, cloud);
+        }
+        per_scan.fuse_pending();
+        let mut batch = RtreeGrid::new(config).unwrap();
+        batch.insert_clouds(clouds.iter().map(|(p, c)| (p, c)));
+        check(&batch);
+        prop_assert_eq!(leaf_set(&batch), leaf_set(&per_scan));
+        prop_assert_eq!(batch.num_leaves(), per_scan.num_leaves());
+    }
+}
