@@ -66,10 +66,12 @@ fn grid(ctx: &EvalContext, set: &str, equal: bool) -> Result<Value> {
     }
     let started = Instant::now();
     let mut grid = RtreeGrid::new(config)?;
-    for node in &data.graph.nodes {
-        grid.insert_cloud(&node.world_from_sensor, &node.points);
-    }
-    grid.fuse_pending();
+    grid.insert_clouds(
+        data.graph
+            .nodes
+            .iter()
+            .map(|n| (&n.world_from_sensor, &n.points)),
+    );
     grid.shrink_to_fit();
     let seconds = started.elapsed().as_secs_f64();
     Ok(

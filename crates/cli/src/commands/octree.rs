@@ -10,14 +10,18 @@
 //! origin — OctoMap's `scan.dat`).
 //!
 //! Prints nodes, leaves, bytes and times; `--json` prints one object with the keys
-//! `input`, `scans`, `points`, `resolution_m`, `model`, `fusion`, `fusion_interval_scans`,
-//! `max_entries`, `min_entries`,
+//! `input`, `scans`, `points`, `resolution_m`, `model`, `fusion`, `seeds`,
+//! `fusion_interval_scans`, `max_entries`, `min_entries`,
 //! `nodes`, `leaves`, `occupied_leaves`, `fused_leaves`, `height`, `base_cubes`, `bytes`,
 //! `insert_secs`, `insert_us_per_point`, `access_secs`, `out`.
 //! `--fusion clamped` (default) is the thesis' rule: only clamped cells fuse. `--fusion equal`
 //! is our extension: cells with bit-equal log-odds fuse (OctoMap's pruning rule, with
 //! cuboids), and fused cells are split where a scan changes part of them, so the map equals
 //! an unfused grid at every base cube.
+//! `--seeds samples` (default) starts fusions from the thesis' selection (end points plus
+//! cells sampled along the beams); `--seeds all` from every updated cell: more fusion, and
+//! with `--fusion equal --fusion-interval 10` the fastest of the variants measured in
+//! `docs/results/octomap.md`.
 //! `--out FILE` writes the map: `.bt` as an OctoMap tree at the base resolution, `.ply` as a
 //! mesh of the occupied cuboids.
 //!
@@ -35,7 +39,7 @@ use nalgebra::Point3;
 use raypath_geometry::{PointCloud, Pose3};
 use raypath_io::foxglove::{frame, topic};
 use raypath_io::octomap::read_graph;
-use raypath_rtree_grid::{Cuboid, FusionRule, GridConfig, RtreeGrid, SensorModel};
+use raypath_rtree_grid::{Cuboid, FusionRule, GridConfig, RtreeGrid, Selection, SensorModel};
 use serde_json::json;
 
 use super::Failure;
@@ -59,6 +63,15 @@ pub enum FusionArg {
     /// Ours: cells with equal log-odds fuse, split again on partial updates; the map stays
     /// exact.
     Equal,
+}
+
+/// `--seeds`: which cells start fusions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SeedsArg {
+    /// The thesis: end-point cells plus cells sampled along the beams (one per 10 cubes).
+    Samples,
+    /// Every cell a scan updated.
+    All,
 }
 
 /// Arguments of `raypath octree`.
@@ -86,6 +99,9 @@ pub struct Args {
     /// Fusion rule.
     #[arg(long, value_enum, default_value_t = FusionArg::Clamped, value_name = "RULE")]
     pub fusion: FusionArg,
+    /// Which cells start fusions.
+    #[arg(long, value_enum, default_value_t = SeedsArg::Samples, value_name = "WHICH")]
+    pub seeds: SeedsArg,
     /// Fuse after every this many scans (1: the thesis; larger: fewer splits of fused cells
     /// on a moving sensor; pending fusions run after the last scan).
     #[arg(long, default_value_t = 1, value_name = "N")]
@@ -195,6 +211,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     config.fusion = !args.no_fusion;
     config.fusion_rule = fusion_rule;
     config.fusion_interval_scans = args.fusion_interval;
+    if args.seeds == SeedsArg::All {
+        config.selection = Selection::UpdatedCells;
+    }
     let mut grid = RtreeGrid::new(config).map_err(Failure::input)?;
     let mut recording = Recording::open(&args.record)?;
     let (scans, stamps) = load(args)?;
@@ -202,12 +221,12 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let points: usize = scans.iter().map(|(_, c)| c.num_valid()).sum();
     let started = Instant::now();
     let bar = super::console::progress(scans.len(), "insertion");
-    for (pose, cloud) in &scans {
-        grid.insert_cloud(pose, cloud);
+    // One batch: fusions at the interval and after the last scan.
+    grid.insert_clouds(scans.iter().map(|(pose, cloud)| {
         bar.inc(1);
-    }
+        (pose, cloud)
+    }));
     bar.finish_and_clear();
-    grid.fuse_pending();
     super::console::stage("insertion and fusion", started);
     let insert_secs = started.elapsed().as_secs_f64();
     grid.shrink_to_fit();
@@ -232,6 +251,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "resolution_m": args.resolution,
             "model": super::choice_name(&args.model),
             "fusion": super::choice_name(&args.fusion),
+            "seeds": super::choice_name(&args.seeds),
             "fusion_interval_scans": config.fusion_interval_scans,
             "max_entries": config.max_entries,
             "min_entries": config.min_entries,
