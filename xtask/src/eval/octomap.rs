@@ -52,6 +52,9 @@ const EQUAL_UPDATED_LABEL: &str = "equal-value fusion + split-on-update (ours, e
 
 /// Variant label of the equal-value rule fusing every 10 scans and after the last one.
 const EQUAL_BATCH_LABEL: &str = "equal-value fusion + split-on-update (ours, beam samples, fused every 10 scans and at the end)";
+/// Variant label of the equal-value rule seeded from every updated cell, fusing every 10
+/// scans and after the last one.
+const EQUAL_UPDATED_BATCH_LABEL: &str = "equal-value fusion + split-on-update (ours, every updated cell, fused every 10 scans and at the end)";
 
 /// The evaluation in stages: one unit per data set (`--shard i/n` and `eval merge`).
 pub const STAGED: Staged = Staged {
@@ -230,11 +233,14 @@ fn summary_section(summary: &Summary, gap_note: &str) -> Result<String> {
          stays exact: a fused cell whose value a scan changes for only part of its base cubes \
          is split (the changed cubes, plus halving cuboids with the old value) before the \
          updates apply, so each base cube holds the log-odds of an unfused lattice. Rows in \
-         the Variants table; figures under `summary.equal_value` (thesis selection) and \
-         `summary.equal_value_updated_cells` and `summary.equal_value_every_10_scans` (fusion \
-         every 10 scans and after the last; the map's values do not depend on when fusion \
-         runs, only how often fused cells are split and re-fused) in the JSON, which also \
-         lists every variant under `variants`.\n"
+         the Variants table; figures under `summary.equal_value` (thesis selection), \
+         `summary.equal_value_updated_cells`, `summary.equal_value_every_10_scans` and \
+         `summary.equal_value_updated_cells_every_10_scans` (fusion every 10 scans and after \
+         the last; the map's values do not depend on when fusion runs, only how often fused \
+         cells are split and re-fused) in the JSON, which also lists every variant under \
+         `variants`. Every variant inserts the scans of a data set as one batch \
+         (`RtreeGrid::insert_clouds`): with a fusion interval above one scan, the cells of the \
+         scans between two fusion passes enter the R-tree only after the pass.\n"
     )?;
     writeln!(
         md,

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use super::data::Dataset;
 use super::peer::{self, PeerRun};
-use super::{EQUAL_BATCH_LABEL, EQUAL_LABEL, EQUAL_UPDATED_LABEL};
+use super::{EQUAL_BATCH_LABEL, EQUAL_LABEL, EQUAL_UPDATED_BATCH_LABEL, EQUAL_UPDATED_LABEL};
 
 /// One unit's result: the data set's measurements (`None`: its data are absent), whether
 /// OctoMap could be built, and (for the simulated drive's unit) the note on how far
@@ -216,7 +216,7 @@ fn run_peer(driver: &Path, set: &Dataset, r: f64, endpoint: bool) -> Result<Peer
 }
 
 /// The variants of our grid, by label, from the thesis' configuration `base`.
-fn variant_configs(base: GridConfig) -> [(&'static str, GridConfig); 7] {
+fn variant_configs(base: GridConfig) -> [(&'static str, GridConfig); 8] {
     let equal = GridConfig {
         fusion_rule: FusionRule::EqualValue,
         ..base
@@ -259,6 +259,14 @@ fn variant_configs(base: GridConfig) -> [(&'static str, GridConfig); 7] {
                 ..equal
             },
         ),
+        (
+            EQUAL_UPDATED_BATCH_LABEL,
+            GridConfig {
+                selection: Selection::UpdatedCells,
+                fusion_interval_scans: 10,
+                ..equal
+            },
+        ),
     ]
 }
 
@@ -294,11 +302,10 @@ fn variants(set: &Dataset, r: f64, peer: Option<&PeerRun>) -> Result<Vec<Variant
 fn run_config(set: &Dataset, config: GridConfig) -> Result<OursRun> {
     let mut grid = RtreeGrid::new(config)?;
     let started = Instant::now();
-    for node in &set.graph.nodes {
-        grid.insert_cloud(&node.world_from_sensor, &node.points);
-    }
-    // Fusions still pending with a fusion interval > 1 scan (a no-op otherwise).
-    grid.fuse_pending();
+    // One batch: fusions at the interval and after the last scan (the same leaves as
+    // `insert_cloud` per scan and `fuse_pending`).
+    let scans = set.graph.nodes.iter();
+    grid.insert_clouds(scans.map(|n| (&n.world_from_sensor, &n.points)));
     let insert_secs = started.elapsed().as_secs_f64();
     grid.shrink_to_fit();
     let started = Instant::now();

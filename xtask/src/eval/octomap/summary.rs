@@ -5,7 +5,7 @@ use anyhow::Result;
 use serde_json::{Value, json};
 
 use super::measure::{Compared, SetInfo};
-use super::{EQUAL_BATCH_LABEL, EQUAL_LABEL, EQUAL_UPDATED_LABEL};
+use super::{EQUAL_BATCH_LABEL, EQUAL_LABEL, EQUAL_UPDATED_BATCH_LABEL, EQUAL_UPDATED_LABEL};
 use crate::eval::comparable;
 use crate::table::{Table, fmt_num};
 
@@ -69,12 +69,13 @@ impl Sums {
     }
 }
 
-/// The summary: the thesis' rule and the three equal-value variants.
+/// The summary: the thesis' rule and the four equal-value variants.
 pub struct Summary {
     /// The thesis' rule (the runs at r = 0.2 m, M = 8, beam-based).
     pub thesis: Sums,
-    /// The equal-value rule: beam samples, every updated cell, fused every 10 scans.
-    equal: [Sums; 3],
+    /// The equal-value rule: beam samples, every updated cell, beam samples fused every 10
+    /// scans, every updated cell fused every 10 scans.
+    equal: [Sums; 4],
 }
 
 impl Summary {
@@ -89,7 +90,12 @@ impl Summary {
                 summary.thesis.add(&set.name, &run.compared);
             }
             for variant in &set.variants {
-                let labels = [EQUAL_LABEL, EQUAL_UPDATED_LABEL, EQUAL_BATCH_LABEL];
+                let labels = [
+                    EQUAL_LABEL,
+                    EQUAL_UPDATED_LABEL,
+                    EQUAL_BATCH_LABEL,
+                    EQUAL_UPDATED_BATCH_LABEL,
+                ];
                 if let Some(k) = labels.iter().position(|l| *l == variant.label) {
                     summary.equal[k].add(&set.name, &variant.compared);
                 }
@@ -105,6 +111,7 @@ impl Summary {
         json["equal_value"] = self.equal[0].json();
         json["equal_value_updated_cells"] = self.equal[1].json();
         json["equal_value_every_10_scans"] = self.equal[2].json();
+        json["equal_value_updated_cells_every_10_scans"] = self.equal[3].json();
         json["real"] = json!(real_rows);
         json
     }
@@ -119,6 +126,7 @@ impl Summary {
             "beam samples",
             "every updated cell",
             "beam samples, fused every 10 scans",
+            "every updated cell, fused every 10 scans",
         ]) {
             table.row(equal_row(sums, label));
         }
