@@ -65,6 +65,22 @@ pub fn morton(key: Key) -> u64 {
     spread(key[0]) | (spread(key[1]) << 1) | (spread(key[2]) << 2)
 }
 
+/// Inverse of [`morton`].
+#[inline]
+pub fn from_morton(code: u64) -> Key {
+    /// Gathers every third bit of `x` into the low 16 bits.
+    fn compact(x: u64) -> u16 {
+        let mut x = x & 0x1249_2492_4924_9249;
+        x = (x | (x >> 2)) & 0x10C3_0C30_C30C_30C3;
+        x = (x | (x >> 4)) & 0x100F_00F0_0F00_F00F;
+        x = (x | (x >> 8)) & 0x001F_0000_FF00_00FF;
+        x = (x | (x >> 16)) & 0x001F_0000_0000_FFFF;
+        x = (x | (x >> 32)) & 0xFFFF;
+        x as u16
+    }
+    [compact(code), compact(code >> 1), compact(code >> 2)]
+}
+
 /// An axis-aligned box of base cubes: keys `lo[a] ..= hi[a]` on each axis `a`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct KeyBox {
@@ -188,6 +204,7 @@ mod tests {
                 }
             }
             assert_eq!(morton(key), naive, "{key:?}");
+            assert_eq!(from_morton(naive), key);
         }
     }
 }

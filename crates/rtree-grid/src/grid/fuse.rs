@@ -4,7 +4,7 @@
 
 use super::{RtreeGrid, SensorModel};
 use crate::config::FusionRule;
-use crate::key::{Key, KeyBox};
+use crate::key::{Key, KeyBox, from_morton, morton};
 
 /// One search direction: an axis and a sign.
 type Direction = (usize, bool);
@@ -48,6 +48,53 @@ fn slab(bx: &KeyBox, (axis, positive): Direction) -> Option<KeyBox> {
     s.lo[axis] = u16::try_from(lo).ok()?;
     s.hi[axis] = u16::try_from(hi).ok()?;
     Some(s)
+}
+
+/// Fusion seeds: the Morton codes of the lower and upper corners of the cells selected since
+/// the last fusion pass (16 bytes a seed). A fusion interval of several scans selects the same
+/// cells again and again, so the list is sorted and de-duplicated whenever it has doubled.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Seeds {
+    codes: Vec<(u64, u64)>,
+    unique: usize,
+}
+
+impl Seeds {
+    #[inline]
+    pub(super) fn push(&mut self, bx: &KeyBox) {
+        self.codes.push((morton(bx.lo), morton(bx.hi)));
+    }
+
+    /// Sorts and de-duplicates once the list has doubled since the last time.
+    pub(super) fn tidy(&mut self) {
+        if self.codes.len() > 2 * self.unique + 4096 {
+            self.sort();
+        }
+    }
+
+    fn sort(&mut self) {
+        self.codes.sort_unstable();
+        self.codes.dedup();
+        self.unique = self.codes.len();
+    }
+
+    /// The lower corners of the seeds in Morton order of the lower, then of the upper
+    /// corners, each box once; empties the list (keeping its buffer).
+    fn drain_sorted(&mut self) -> impl Iterator<Item = Key> + '_ {
+        self.sort();
+        self.unique = 0;
+        self.codes.drain(..).map(|(lo, _)| from_morton(lo))
+    }
+
+    /// Bytes held (kept between passes).
+    pub(super) fn memory_bytes(&self) -> usize {
+        self.codes.capacity() * size_of::<(u64, u64)>()
+    }
+
+    /// Releases spare capacity.
+    pub(super) fn shrink_to_fit(&mut self) {
+        self.codes.shrink_to_fit();
+    }
 }
 
 /// The cells of one fusion pass that no slab can join: within a pass a slab that failed
@@ -96,6 +143,23 @@ impl Settled {
 }
 
 impl RtreeGrid {
+    /// Fuses from the selected cells in Morton order of their lower corners (then of their
+    /// upper corners); a seed fused into a larger cell or split since it was selected starts
+    /// from the cell now holding its lower corner. The leaves depend on the scans only, not
+    /// on cell ids or the tree's shape.
+    pub(super) fn fuse_seeds(&mut self) -> usize {
+        let mut seeds = std::mem::take(&mut self.selected);
+        let mut steps = 0;
+        for lo in seeds.drain_sorted() {
+            if let Some(id) = self.cell_id_of_key(lo) {
+                steps += self.fuse(id);
+            }
+        }
+        self.selected = seeds;
+        self.settled.clear();
+        steps
+    }
+
     /// Runs `Fuse(g_i)` on cell `id` (repeating on the fused cell, the thesis' recursive
     /// call); returns the number of fusion steps. A cell settled earlier in the pass is
     /// skipped (the result is the same).

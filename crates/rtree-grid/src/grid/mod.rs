@@ -14,7 +14,7 @@ use raypath_geometry::{PointCloud, Pose3};
 use crate::config::{FusionRule, GridConfig, Selection, SensorModel, logit};
 use crate::fused_index::FusedIndex;
 use crate::index::LatticeIndex;
-use crate::key::{Key, KeyBox, morton, pack, unpack};
+use crate::key::{Key, KeyBox, pack, unpack};
 use crate::rtree::{OrderError, RTree};
 
 pub use query::{Cuboid, Occupancy};
@@ -100,10 +100,9 @@ pub struct RtreeGrid {
     occupied_keys: Vec<u64>,
     touched_fused: Vec<(u32, bool)>,
     touched_exact: Vec<(u32, u64, bool)>,
-    /// Fusion seeds: boxes of the cells selected since the last fusion pass.
-    selected: Vec<KeyBox>,
-    /// Fusion scratch: the seeds with their Morton codes, and a slab's member cells.
-    seed_order: Vec<(u64, u64, KeyBox)>,
+    /// Fusion seeds: the cells selected since the last fusion pass.
+    selected: fuse::Seeds,
+    /// Fusion scratch: a slab's member cells.
     members: Vec<u32>,
     /// Cells of the running fusion pass that cannot grow.
     settled: fuse::Settled,
@@ -191,9 +190,8 @@ impl RtreeGrid {
             occupied_keys: Vec::new(),
             touched_fused: Vec::new(),
             touched_exact: Vec::new(),
-            selected: Vec::new(),
+            selected: fuse::Seeds::default(),
             recent: ray::RecentKeys::new(),
-            seed_order: Vec::new(),
             members: Vec::new(),
             settled: fuse::Settled::default(),
         })
@@ -311,6 +309,8 @@ impl RtreeGrid {
         let fuse = self.config.fusion && self.scans % interval == 0;
         if fuse {
             update.fusions += self.fuse_seeds();
+        } else {
+            self.selected.tidy();
         }
         if fuse || commit {
             self.commit();
@@ -328,7 +328,7 @@ impl RtreeGrid {
         &mut self,
         free_keys: &[u64],
         occupied_keys: &[u64],
-        selected: &mut Vec<KeyBox>,
+        selected: &mut fuse::Seeds,
         update: &mut ScanUpdate,
     ) {
         // §2.5.2, Fig. 2.6: end-point cells always start fusions; each cell a beam traversed does
@@ -369,7 +369,7 @@ impl RtreeGrid {
                             || rng.next_f64() < sample_probability);
                     // Only cells that may fuse start fusions (checked again when fusing).
                     if chosen && self.may_fuse(self.lo(id)) {
-                        selected.push(bx);
+                        selected.push(&bx);
                     }
                 }
             }
@@ -381,31 +381,6 @@ impl RtreeGrid {
     pub fn fuse_pending(&mut self) -> usize {
         let steps = self.fuse_seeds();
         self.commit();
-        steps
-    }
-
-    /// Fuses from the selected cells in Morton order of their lower corners (then of their
-    /// upper corners); a seed fused into a larger cell or split since it was selected starts
-    /// from the cell now holding its lower corner. The leaves depend on the scans only, not
-    /// on cell ids or the tree's shape.
-    fn fuse_seeds(&mut self) -> usize {
-        let mut order = std::mem::take(&mut self.seed_order);
-        order.clear();
-        order.extend(
-            self.selected
-                .drain(..)
-                .map(|b| (morton(b.lo), morton(b.hi), b)),
-        );
-        order.sort_unstable_by_key(|&(lo, hi, _)| (lo, hi));
-        order.dedup_by_key(|&mut (lo, hi, _)| (lo, hi));
-        let mut steps = 0;
-        for &(_, _, seed) in &order {
-            if let Some(id) = self.cell_id_of_key(seed.lo) {
-                steps += self.fuse(id);
-            }
-        }
-        self.seed_order = order;
-        self.settled.clear();
         steps
     }
 
@@ -521,14 +496,15 @@ impl RtreeGrid {
     }
 
     /// Bytes allocated by the map: the tree arena (with the cells' boxes and log-odds), the
-    /// free list, the lattice and fused-cell indexes and the bit set of cells not yet in the
-    /// tree (excluding per-scan scratch vectors).
+    /// free list, the lattice and fused-cell indexes, the bit set of cells not yet in the
+    /// tree and the pending fusion seeds (excluding per-scan scratch vectors).
     pub fn memory_bytes(&self) -> usize {
         self.tree.memory_bytes()
             + self.free_cells.capacity() * 4
             + self.index.memory_bytes()
             + self.fused.memory_bytes()
             + self.pending.memory_bytes()
+            + self.selected.memory_bytes()
             + size_of::<Self>()
     }
 
@@ -559,7 +535,6 @@ impl RtreeGrid {
         self.selected.shrink_to_fit(); // pending fusion seeds are kept
         self.touched_fused = Vec::new();
         self.touched_exact = Vec::new();
-        self.seed_order = Vec::new();
         self.members = Vec::new();
         self.settled = fuse::Settled::default();
     }

@@ -17,7 +17,7 @@ impl RtreeGrid {
     /// changed base cubes join `selected` (fusion seeds) when fusion is on.
     pub(super) fn apply_exact_updates(
         &mut self,
-        selected: &mut Vec<KeyBox>,
+        selected: &mut super::fuse::Seeds,
         update: &mut ScanUpdate,
     ) {
         let mut touched = std::mem::take(&mut self.touched_exact);
@@ -63,7 +63,7 @@ impl RtreeGrid {
         bx: KeyBox,
         old: f32,
         changed: &mut [(Key, f32)],
-        selected: &mut Vec<KeyBox>,
+        selected: &mut super::fuse::Seeds,
     ) {
         if changed.is_empty() {
             self.create_cell(bx, old);
@@ -72,7 +72,7 @@ impl RtreeGrid {
         if bx.volume() == 1 {
             self.create_cell(bx, changed[0].1);
             if self.config.fusion && self.may_fuse(changed[0].1) {
-                selected.push(bx);
+                selected.push(&bx);
             }
             return;
         }
