@@ -14,7 +14,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use raypath_planes::PpeParams;
 use raypath_poles::{LabelledLocalMap, PoleParams};
-use raypath_rtree_grid::{FusionRule, GridConfig, RtreeGrid, SensorModel};
+use raypath_rtree_grid::{FusionRule, GridConfig, RtreeGrid, Selection, SensorModel};
 use serde_json::{Value, json};
 
 use super::octomap::{Dataset, build_peer, dataset, run_peer};
@@ -49,20 +49,26 @@ pub fn probe(workload: &str, quick: bool) -> Result<()> {
     let result = match (set, rule) {
         ("poles", _) => poles(&ctx)?,
         ("ppe", _) => ppe(&ctx)?,
-        (set, "thesis" | "equal") => grid(&ctx, set, rule == "equal")?,
+        (set, "thesis" | "equal" | "equal-batched") => grid(&ctx, set, rule)?,
         _ => bail!("memory-probe: no workload {workload:?}"),
     };
     println!("{result}");
     Ok(())
 }
 
-/// The grid on a real scan set: `(input KiB, seconds, grid bytes)` in the JSON line.
-fn grid(ctx: &EvalContext, set: &str, equal: bool) -> Result<Value> {
+/// The grid on a real scan set with fusion `rule` (`thesis`; `equal`: equal-value, the
+/// thesis' seeds, per scan; `equal-batched`: equal-value from every updated cell, fused every
+/// 10 scans): `(input KiB, seconds, grid bytes)` in the JSON line.
+fn grid(ctx: &EvalContext, set: &str, rule: &str) -> Result<Value> {
     let data = dataset(ctx, set)?.with_context(|| format!("{set}: data absent"))?;
     let input = peak_rss_kib();
     let mut config = GridConfig::with(0.2, 8, SensorModel::BeamBased);
-    if equal {
+    if rule != "thesis" {
         config.fusion_rule = FusionRule::EqualValue;
+    }
+    if rule == "equal-batched" {
+        config.selection = Selection::UpdatedCells;
+        config.fusion_interval_scans = 10;
     }
     let started = Instant::now();
     let mut grid = RtreeGrid::new(config)?;
@@ -179,7 +185,14 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
                 None
             }
         };
-        for (rule, label) in [("thesis", "thesis rule"), ("equal", "equal-value")] {
+        for (rule, label) in [
+            ("thesis", "thesis rule"),
+            ("equal", "equal-value"),
+            (
+                "equal-batched",
+                "equal-value, every cell, fused every 10 scans",
+            ),
+        ] {
             let ours = child(ctx, &format!("{set}/{rule}"))?;
             table.row(grid_row(&data, label, &ours, peer.as_ref()));
             rows.push(
