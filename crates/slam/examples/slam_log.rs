@@ -103,6 +103,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(r) = env("SLAM_RANGE") {
         config.filter.max_range_m = r;
     }
+    if let (Some(r), Some(l)) = (env("SLAM_AMBIG"), config.loops.as_mut()) {
+        l.ambiguity_ratio = Some(r);
+        if let Some(d) = env("SLAM_AMBIG_DEG") {
+            l.ambiguity_min_angle_rad = d.to_radians();
+        }
+    }
     let t0 = Instant::now();
     let mut slam = Slam::new(config)?;
     for f in &frames {
@@ -211,6 +217,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
         let (checked, wrong, checks) = raypath_slam::benchmark::check_loops(&out, &reference, 50);
+        println!("loop stats: {:?}", out.stats.loops);
         println!("loop closures: {wrong} of {checked} checked wrong");
         for cut in [0.3, 0.5, 0.7] {
             let low = |wrong: bool| {

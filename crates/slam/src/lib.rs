@@ -53,7 +53,9 @@
 //! * Loop search from every third node against the three nearest finished submaps within
 //!   10 m (+ 2 % of the path since the last loop closure), windows ±1.5 m / ±20°, and one
 //!   place-recognition candidate over ±π; minimum branch-and-bound score 0.55 (Hess et al.'s
-//!   Cartographer default).
+//!   Cartographer default). A match is refused when another heading at least 3° away reaches
+//!   90 % of its score ([`LoopSearchConfig::ambiguity_ratio`]): the one Intel loop closure
+//!   that passed everything else while 8.9° off the corrected log was such a match.
 //! * Constraint σ: sequential and intra-submap (0.02 m, 0.5°), loop (0.05 m, 1°).
 //!
 //! ## Results (`cargo xtask eval slam`, docs/results/slam.md)

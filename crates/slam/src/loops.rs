@@ -13,9 +13,12 @@
 //!   node.
 //!
 //! A candidate becomes a loop constraint when the best pose of the search reaches the minimum
-//! score and the Gauss–Newton refinement stays within [`LoopSearchConfig::max_refinement_m`] of
-//! it. Wrong constraints that pass both are left to the robust pose graph (see
-//! [`crate::graph`]).
+//! score, no heading at least [`LoopSearchConfig::ambiguity_min_angle_rad`] away scores
+//! nearly as well ([`LoopSearchConfig::ambiguity_ratio`]; ours: a corridor or a symmetric room
+//! fits a scan at several headings, and the loop closures that passed every other test and
+//! still disagreed with the corrected logs were rotations), and the Gauss–Newton refinement
+//! stays within [`LoopSearchConfig::max_refinement_m`] of it. Wrong constraints that pass all
+//! three are left to the robust pose graph (see [`crate::graph`]).
 
 use raypath_geometry::{Pose2, Scan2};
 use raypath_place_recognition::{PolarConfig, PolarContext, PolarDescription};
@@ -75,6 +78,8 @@ pub struct LoopStats {
     pub matched: usize,
     /// Matches refused because the refinement moved too far.
     pub refinement_rejected: usize,
+    /// Matches refused as ambiguous in rotation.
+    pub ambiguous_rejected: usize,
 }
 
 /// The loop closer's state: polar-context descriptions of the nodes.
@@ -157,6 +162,10 @@ impl LoopCloser {
                 continue;
             };
             self.stats.matched += 1;
+            if self.rotation_ambiguous(submap, &c, &m) {
+                self.stats.ambiguous_rejected += 1;
+                continue;
+            }
             let (refined, _) =
                 match_levels(submap.levels(), matcher, points, m.submap_from_sensor, None);
             let jump = (m.submap_from_sensor.inverse() * refined)
@@ -169,6 +178,46 @@ impl LoopCloser {
             out.push((c.submap, refined, m.score, c.source));
         }
         out
+    }
+
+    /// Whether a pose at least `ambiguity_min_angle_rad` away in rotation scores nearly as
+    /// well as the match `m` (`ambiguity_ratio` of its score): two more branch-and-bound
+    /// searches, over the headings above and below the match out to the window's width, with
+    /// that share of the score as their minimum (so they prune early when nothing comes close).
+    fn rotation_ambiguous(
+        &self,
+        submap: &Submap,
+        c: &Candidate,
+        m: &crate::correlative::CorrelativeMatch,
+    ) -> bool {
+        let Some(ratio) = self.config.ambiguity_ratio else {
+            return false;
+        };
+        let band = self.config.ambiguity_min_angle_rad;
+        let half = (c.window.angular_rad - band) / 2.0;
+        if half <= 0.0 {
+            return false;
+        }
+        let config = crate::correlative::CorrelativeConfig {
+            min_score: ratio * m.score,
+            ..self.config.correlative
+        };
+        let theta = m.submap_from_sensor.theta();
+        [1.0, -1.0].into_iter().any(|sign| {
+            let initial = Pose2::new(c.initial.x(), c.initial.y(), theta + sign * (band + half));
+            let window = SearchWindow {
+                linear_m: c.window.linear_m,
+                angular_rad: half,
+            };
+            match_scan(
+                submap.precomputed(),
+                &self.thinned,
+                initial,
+                &window,
+                &config,
+            )
+            .is_some()
+        })
     }
 
     fn candidates(
@@ -293,7 +342,92 @@ fn thin(points: &[[f64; 2]], spacing: f64, out: &mut Vec<[f64; 2]>) {
 
 #[cfg(test)]
 mod tests {
-    use super::thin;
+    use super::*;
+    use crate::submap::ActiveSubmap;
+    use raypath_reflectivity::MapConfig;
+
+    /// A frozen submap of one scan at the origin of a room whose walls are `walls` (end
+    /// points every 2 cm).
+    fn room_submap(walls: &[([f64; 2], [f64; 2])]) -> (Submap, Vec<[f64; 2]>) {
+        let mut points = ScanPoints::new();
+        let mut raw = Vec::new();
+        for (p, q) in walls {
+            let n = ((q[0] - p[0]).hypot(q[1] - p[1]) / 0.02) as usize;
+            for k in 0..=n {
+                let t = k as f64 / n as f64;
+                let v = [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])];
+                points.push(v, f64::NAN);
+                raw.push(v);
+            }
+        }
+        let config = MapConfig {
+            size_m: 20.0,
+            ..MapConfig::default()
+        };
+        let mut active = ActiveSubmap::new(&config, 0, Pose2::identity(), 0.0).unwrap();
+        for _ in 0..5 {
+            active.map.update(&Pose2::identity(), &points);
+        }
+        (active.freeze(7).unwrap(), raw)
+    }
+
+    /// Whether the loop closer calls the match of the room's own scan ambiguous.
+    fn ambiguous(walls: &[([f64; 2], [f64; 2])]) -> bool {
+        let (submap, raw) = room_submap(walls);
+        let config = LoopSearchConfig::default();
+        let mut closer = LoopCloser::new(config, 30.0).unwrap();
+        thin(&raw, config.thinning_m, &mut closer.thinned);
+        let candidate = Candidate {
+            submap: 0,
+            initial: Pose2::new(0.1, -0.1, 0.05),
+            window: SearchWindow {
+                linear_m: 0.5,
+                angular_rad: config.angular_window_rad,
+            },
+            source: LoopSource::Nearby,
+        };
+        let m = match_scan(
+            submap.precomputed(),
+            &closer.thinned,
+            candidate.initial,
+            &candidate.window,
+            &config.correlative,
+        )
+        .expect("the room's own scan matches");
+        assert!(m.submap_from_sensor.translation().norm() < 0.06);
+        closer.rotation_ambiguous(&submap, &candidate, &m)
+    }
+
+    #[test]
+    fn a_round_room_is_ambiguous_in_rotation_a_square_one_with_a_corner_is_not() {
+        let polygon = |n: usize, r: f64| -> Vec<([f64; 2], [f64; 2])> {
+            (0..n)
+                .map(|k| {
+                    let a = |k: usize| k as f64 * std::f64::consts::TAU / n as f64;
+                    (
+                        [r * a(k).cos(), r * a(k).sin()],
+                        [r * a(k + 1).cos(), r * a(k + 1).sin()],
+                    )
+                })
+                .collect()
+        };
+        // A 90-gon of radius 4 m looks the same every 4°.
+        assert!(ambiguous(&polygon(90, 4.0)));
+        // A 6 m × 4 m room with a pillar off the centre.
+        let mut room = vec![
+            ([-3.0, -2.0], [3.0, -2.0]),
+            ([3.0, -2.0], [3.0, 2.0]),
+            ([3.0, 2.0], [-3.0, 2.0]),
+            ([-3.0, 2.0], [-3.0, -2.0]),
+        ];
+        room.extend([
+            ([1.0, 0.5], [1.6, 0.5]),
+            ([1.6, 0.5], [1.6, 1.0]),
+            ([1.6, 1.0], [1.0, 1.0]),
+            ([1.0, 1.0], [1.0, 0.5]),
+        ]);
+        assert!(!ambiguous(&room));
+    }
 
     #[test]
     fn thinning_keeps_one_point_per_spacing() {
