@@ -137,7 +137,14 @@ fn equal_value_fusion_keeps_the_volume_and_fuses_a_single_scan() {
     assert_eq!(batch["base_cubes"], plain["base_cubes"]);
     assert!(batch["fused_leaves"].as_u64().unwrap() > 0);
     // Seeds from every updated cell fuse at least as much, over the same cubes.
-    let all = run(&["--fusion", "equal", "--seeds", "all", "--fusion-interval", "4"]);
+    let all = run(&[
+        "--fusion",
+        "equal",
+        "--seeds",
+        "all",
+        "--fusion-interval",
+        "4",
+    ]);
     assert_eq!(all["seeds"], "all");
     assert_eq!(batch["seeds"], "samples");
     assert_eq!(all["base_cubes"], plain["base_cubes"]);
