@@ -104,7 +104,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         config.filter.max_range_m = r;
     }
     if let (Some(r), Some(l)) = (env("SLAM_AMBIG"), config.loops.as_mut()) {
-        l.ambiguity_ratio = Some(r);
+        l.ambiguity_ratio = (r > 0.0).then_some(r);
         if let Some(d) = env("SLAM_AMBIG_DEG") {
             l.ambiguity_min_angle_rad = d.to_radians();
         }
