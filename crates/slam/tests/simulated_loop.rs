@@ -178,6 +178,15 @@ fn bad_scans_are_errors_not_panics() {
         })
         .is_err()
     );
+    // The rotation-ambiguity test's parameters are checked, with the field named.
+    for (ratio, angle) in [(Some(1.5), 0.05), (Some(0.0), 0.05), (Some(0.9), f64::NAN)] {
+        let mut config = SlamConfig::default();
+        let loops = config.loops.as_mut().unwrap();
+        loops.ambiguity_ratio = ratio;
+        loops.ambiguity_min_angle_rad = angle;
+        let err = Slam::new(config).unwrap_err().to_string();
+        assert!(err.contains("ambiguity"), "{err}");
+    }
 }
 
 /// Jumps in the odometry (as the raw MIT CSAIL log has: 0.5–0.9 m and 30–50° between two
