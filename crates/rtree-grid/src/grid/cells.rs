@@ -8,6 +8,7 @@
 //! Guttman's Delete for the cells of the tree that died, then Insert for the new cells that
 //! live (Khan 2017, §2.4) — so between public calls the tree holds exactly the leaves.
 
+use super::id_bits::IdBits;
 use super::{Cell, RtreeGrid};
 use crate::index::LatticeIndex;
 use crate::key::{Key, KeyBox, pack};
@@ -25,7 +26,7 @@ pub(super) struct Pending {
     /// Cells created since the last commit (some may have died since).
     created: Vec<u32>,
     /// One bit per cell id: created since the last commit and alive.
-    fresh: Vec<u64>,
+    fresh: IdBits,
     /// Cells of the tree deleted since the last commit (their ids are reused after it).
     dead: Vec<u32>,
     /// Commit scratch: the live new cells (lattice order key, id, box).
@@ -35,28 +36,18 @@ pub(super) struct Pending {
 impl Pending {
     #[inline]
     fn set(&mut self, id: u32) {
-        let word = id as usize / 64;
-        if word >= self.fresh.len() {
-            self.fresh.resize(word + 1, 0);
-        }
-        self.fresh[word] |= 1 << (id % 64);
+        self.fresh.insert(id);
     }
 
     /// Clears the bit of `id`; returns whether it was set.
     #[inline]
     fn take(&mut self, id: u32) -> bool {
-        let Some(word) = self.fresh.get_mut(id as usize / 64) else {
-            return false;
-        };
-        let bit = 1 << (id % 64);
-        let was = *word & bit != 0;
-        *word &= !bit;
-        was
+        self.fresh.remove(id)
     }
 
     /// Bytes of the bit set (the lists are per-scan scratch).
     pub(super) fn memory_bytes(&self) -> usize {
-        self.fresh.capacity() * size_of::<u64>()
+        self.fresh.memory_bytes()
     }
 
     /// Releases spare capacity (nothing may be pending).

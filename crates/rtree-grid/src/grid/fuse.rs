@@ -2,6 +2,7 @@
 //! the fusion conditions (Eqs. 2.9–2.11, §2.5.2) omit: as printed, a fused cuboid could
 //! swallow unknown space or overlap a neighbouring cell.
 
+use super::id_bits::IdBits;
 use super::{RtreeGrid, SensorModel};
 use crate::config::FusionRule;
 use crate::key::{Key, KeyBox, from_morton, morton};
@@ -103,40 +104,30 @@ impl Seeds {
 /// slab walks. A bit per cell id; an id freed and reused within the pass loses its bit.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Settled {
-    bits: Vec<u64>,
+    bits: IdBits,
     ids: Vec<u32>,
 }
 
 impl Settled {
     fn mark(&mut self, id: u32) {
-        let word = id as usize / 64;
-        if word >= self.bits.len() {
-            self.bits.resize(word + 1, 0);
-        }
-        self.bits[word] |= 1 << (id % 64);
+        self.bits.insert(id);
         self.ids.push(id);
     }
 
     fn contains(&self, id: u32) -> bool {
-        self.bits
-            .get(id as usize / 64)
-            .is_some_and(|w| w & (1 << (id % 64)) != 0)
+        self.bits.contains(id)
     }
 
     /// Forgets `id` (a new cell took it).
     #[inline]
     pub(super) fn unmark(&mut self, id: u32) {
-        if let Some(w) = self.bits.get_mut(id as usize / 64) {
-            *w &= !(1 << (id % 64));
-        }
+        self.bits.remove(id);
     }
 
     /// Forgets every cell (the end of a pass).
     pub(super) fn clear(&mut self) {
         for &id in &self.ids {
-            if let Some(w) = self.bits.get_mut(id as usize / 64) {
-                *w = 0;
-            }
+            self.bits.remove(id);
         }
         self.ids.clear();
     }

@@ -2,6 +2,7 @@
 
 mod cells;
 mod fuse;
+mod id_bits;
 mod query;
 mod ray;
 mod split;
