@@ -319,6 +319,20 @@ fn planar_commands_read_a_bag_like_the_log() {
     );
     assert!(close(x, y, 1e-3), "{x} vs {y}");
     assert!(y.as_f64().unwrap() < 0.05, "{b}");
+    assert!(b["wrong_loop_closures_reference_disputed"].is_u64(), "{b}");
+    // The bag's own poses refined by their scans: relations kept or counted, none lost.
+    let refined = &b["scan_refined"];
+    let dropped: u64 = refined["dropped"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|v| v.as_u64().unwrap())
+        .sum();
+    assert_eq!(
+        refined["summary"]["relations"].as_u64().unwrap() + dropped,
+        b["summary"]["relations"].as_u64().unwrap(),
+        "{refined}"
+    );
     assert!(d.join("slam-bag/trajectory.txt").exists());
     assert!(d.join("slam-bag/map.pgm").exists());
 

@@ -10,7 +10,10 @@ use std::time::Instant;
 
 use raypath_geometry::Pose2;
 use raypath_io::sequence::{PlanarOptions, pair_reference, read_planar};
-use raypath_slam::benchmark::{consecutive_relations, random_relations, relation_errors};
+use raypath_slam::benchmark::{
+    RefineConfig, consecutive_relations, explicit_relation_errors, random_relations,
+    refine_relations, relation_errors,
+};
 use raypath_slam::{Slam, SlamConfig};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -174,6 +177,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let odo: Vec<_> = frames.iter().map(|f| f.world_from_laser).collect();
         let o = relation_errors(&reference, &odo, &consecutive_relations(&referenced));
         println!("consecutive: {c:?}\nrandom: {r:?}\nodometry consecutive: {o:?}");
+        {
+            let scans: Vec<_> = frames.iter().map(|f| &f.scan).collect();
+            let started = Instant::now();
+            let refined = refine_relations(
+                &scans,
+                &reference,
+                &consecutive_relations(&referenced),
+                &RefineConfig::default(),
+            );
+            let moved = refined.corrections_m.iter().sum::<f64>()
+                / refined.corrections_m.len().max(1) as f64;
+            println!(
+                "scan-refined: {:?} in {:.1} s; kept {}, reference moved {moved:.4} m on average, dropped {:?}",
+                explicit_relation_errors(&out.world_from_sensor, &refined.relations),
+                started.elapsed().as_secs_f64(),
+                refined.relations.len(),
+                refined.dropped
+            );
+            println!(
+                "odometry scan-refined: {:?}",
+                explicit_relation_errors(&odo, &refined.relations)
+            );
+        }
         {
             let (mut t, _) = raypath_reflectivity::benchmark::relation_error_lists(
                 |i| reference.get(i).and_then(Option::as_ref),

@@ -11,6 +11,7 @@
 //! ablation (`ablation/<world>`); [`page`] draws the report from their results.
 
 mod page;
+mod refinement;
 
 use std::time::Instant;
 
@@ -21,8 +22,9 @@ use raypath_io::sequence::{PlanarFrame, PlanarOptions, pair_reference, read_plan
 use raypath_reflectivity::benchmark::run_matcher;
 use raypath_reflectivity::{PointFilter, ResidualMode};
 use raypath_slam::benchmark::{
-    ErrorSummary, MatchedRelations, check_loops, consecutive_relations, file_relation_errors,
-    match_relation_file, random_relations, relation_errors, scan_supported, submap_disagreement,
+    ErrorSummary, MatchedRelations, RefineConfig, Refined, check_loops, consecutive_relations,
+    explicit_relation_errors, file_relation_errors, match_relation_file, random_relations,
+    refine_relations, relation_errors, scan_supported, submap_disagreement,
 };
 use raypath_slam::graph::RobustKernel;
 use raypath_slam::{Slam, SlamConfig, SlamOutput};
@@ -70,6 +72,8 @@ struct Scored {
     consecutive: ErrorSummary,
     /// Over the scan-supported consecutive relations only ([`scan_supported`]).
     supported: ErrorSummary,
+    /// Over the scan-refined consecutive relations ([`refine_relations`]).
+    refined: ErrorSummary,
     random: ErrorSummary,
     loops: usize,
     rejected: usize,
@@ -110,6 +114,8 @@ struct Relations {
     truth: Vec<Option<Pose2>>,
     consecutive: Vec<(usize, usize)>,
     supported: Vec<(usize, usize)>,
+    /// The consecutive relations refined by aligning their scans.
+    refined: Refined,
     random: Vec<(usize, usize)>,
     /// The benchmark's relation file (`carmen/relations/<log>.relations`), when present.
     file: Option<MatchedRelations>,
@@ -122,11 +128,13 @@ impl Relations {
         let consecutive = consecutive_relations(&referenced);
         let scans: Vec<&raypath_geometry::Scan2> = frames.iter().map(|f| &f.scan).collect();
         let supported = scan_supported(&scans, &truth, &consecutive);
+        let refined = refine_relations(&scans, &truth, &consecutive, &RefineConfig::default());
         let random = random_relations(&referenced, RANDOM_PAIRS, SEED);
         Self {
             truth,
             consecutive,
             supported,
+            refined,
             random,
             file: None,
         }
@@ -164,6 +172,7 @@ fn score(
     let truth = &rel.truth;
     let consecutive = relation_errors(truth, poses, &rel.consecutive);
     let supported = relation_errors(truth, poses, &rel.supported);
+    let refined = explicit_relation_errors(poses, &rel.refined.relations);
     let random = relation_errors(truth, poses, &rel.random);
     let benchmark = rel.file.as_ref().map(|m| file_relation_errors(poses, m));
     let (mut wrong, mut checked, mut loops, mut rejected, mut disputed) = (0, 0, 0, 0, 0);
@@ -178,6 +187,7 @@ fn score(
     Scored {
         consecutive,
         supported,
+        refined,
         random,
         loops,
         rejected,
@@ -199,7 +209,7 @@ fn row_json(log: &str, method: &str, s: &Scored) -> Value {
     };
     json!({
         "log": log, "method": method, "summary": s.consecutive, "random_pairs": s.random,
-        "scan_supported": s.supported,
+        "scan_supported": s.supported, "scan_refined": s.refined,
         "loop_closures": s.loops, "rejected_loop_closures": s.rejected,
         "wrong_loop_closures": s.wrong, "loop_closures_checked": s.checked,
         "wrong_loop_closures_reference_disputed": s.disputed,
@@ -332,7 +342,10 @@ fn referenced(ctx: &EvalContext, name: &str, raw: &str, corrected: &str) -> Resu
         );
         rows.push(row_json(name, label, &s));
     }
-    Ok(json!({ "rows": rows, "relation_file_unmatched": unmatched }))
+    Ok(json!({
+        "rows": rows, "relation_file_unmatched": unmatched,
+        "scan_refinement": refinement::of_reference(name, &relations),
+    }))
 }
 
 /// A log without reference: SLAM with and without loop closure, the submap disagreement of
@@ -378,6 +391,7 @@ fn ablation(ctx: &EvalContext, world: &str) -> Result<Value> {
     }
     pair_reference(&mut frames, &read_planar(&corrected, &options)?);
     let relations = Relations::of(&frames);
+    let check = refinement::check(world, &frames, &relations);
     let mut notes = Vec::new();
     let modes: &[ResidualMode] = if frames.iter().any(|f| f.scan.intensities.is_some()) {
         &[ResidualMode::Occupancy, ResidualMode::Combined]
@@ -410,5 +424,5 @@ fn ablation(ctx: &EvalContext, world: &str) -> Result<Value> {
         }
         rows.push(v);
     }
-    Ok(json!({ "rows": rows, "notes": notes }))
+    Ok(json!({ "rows": rows, "notes": notes, "refinement_check": check }))
 }

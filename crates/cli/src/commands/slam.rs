@@ -26,6 +26,10 @@
 //! whose association error is above 0.3 m or 3°, `raypath_slam::benchmark::check_loops`, of
 //! `"loop_closures_checked"`; `"wrong_loop_closures_reference_disputed"` counts those of
 //! them where the corrected log disagrees with its own scans, `LoopCheck::reference_disputed`).
+//! `"scan_refined": {"summary", "dropped", "reference_moved_m"}` scores the consecutive
+//! relations refined by aligning their two scans and kept where that alignment is unique and
+//! well constrained (`raypath_slam::benchmark::refine_relations`; `dropped` counts the others
+//! by reason, `reference_moved_m` is the mean correction of the corrected log's relations).
 //! With `--relations` (the SLAM benchmark's own relation file of the log, e.g.
 //! `intel.relations`, whose scans are named by the CARMEN ipc time stamps), `"relations_file":
 //! {"path", "summary", "unmatched"}` scores the trajectory by the benchmark's protocol: the
@@ -44,8 +48,8 @@ use raypath_io::sequence::{PlanarFrame, pair_reference};
 use raypath_reflectivity::ResidualMode;
 use raypath_sensor_models::export::{MapFile, StoredStats};
 use raypath_slam::benchmark::{
-    check_loops, consecutive_relations, file_relation_errors, match_relation_file,
-    random_relations, relation_errors,
+    RefineConfig, check_loops, consecutive_relations, explicit_relation_errors,
+    file_relation_errors, match_relation_file, random_relations, refine_relations, relation_errors,
 };
 use raypath_slam::{Slam, SlamConfig, SlamOutput};
 use serde_json::{Value, json};
@@ -297,11 +301,24 @@ fn evaluate(
     );
     let (checked, wrong, checks) = check_loops(out, &truth, NEIGHBOUR_GAP);
     let scans: Vec<_> = frames.iter().map(|f| &f.scan).collect();
+    let refined = refine_relations(
+        &scans,
+        &truth,
+        &consecutive_relations(&referenced),
+        &RefineConfig::default(),
+    );
+    let moved =
+        refined.corrections_m.iter().sum::<f64>() / refined.corrections_m.len().max(1) as f64;
     let disputed = raypath_slam::benchmark::wrong_at_disputed_reference(&checks, &scans, &truth);
     Ok(json!({
         "paired_scans": paired,
         "summary": summary,
         "random_pairs": random,
+        "scan_refined": {
+            "summary": explicit_relation_errors(&out.world_from_sensor, &refined.relations),
+            "dropped": refined.dropped,
+            "reference_moved_m": moved,
+        },
         "loop_closures_checked": checked,
         "wrong_loop_closures": wrong,
         "wrong_loop_closures_reference_disputed": disputed,
@@ -357,16 +374,8 @@ fn report(
         },
         "map": map,
     });
-    if let (Some(e), Some(obj)) = (evaluation, doc.as_object_mut()) {
-        for key in [
-            "paired_scans",
-            "summary",
-            "random_pairs",
-            "loop_closures_checked",
-            "wrong_loop_closures",
-        ] {
-            obj.insert(key.into(), e[key].clone());
-        }
+    if let (Some(Value::Object(e)), Some(obj)) = (evaluation, doc.as_object_mut()) {
+        obj.extend(e);
     }
     doc
 }
@@ -407,6 +416,20 @@ fn print(doc: &Value) {
             s.rot_error_std_deg,
             doc["wrong_loop_closures"],
             doc["loop_closures_checked"],
+        );
+    }
+    if let Ok(s) = serde_json::from_value::<SummaryView>(doc["scan_refined"]["summary"].clone()) {
+        println!(
+            "relation error over {} scan-refined consecutive pairs: {:.4} ± {:.4} m, {:.2} ± {:.2}° \
+             (the refinement moved the reference by {:.4} m on average)",
+            s.relations,
+            s.trans_error_m,
+            s.trans_error_std_m,
+            s.rot_error_deg,
+            s.rot_error_std_deg,
+            doc["scan_refined"]["reference_moved_m"]
+                .as_f64()
+                .unwrap_or(f64::NAN),
         );
     }
     if let Ok(s) = serde_json::from_value::<SummaryView>(doc["relations_file"]["summary"].clone()) {

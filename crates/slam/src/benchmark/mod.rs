@@ -17,16 +17,23 @@
 //! [`raypath_io::relations`]), [`match_relation_file`] finds their scans by the logs' ipc time
 //! stamps and [`file_relation_errors`] scores an estimate against them: the benchmark's own
 //! protocol, like for like with the published figures.
+//!
+//! A corrected log carries the local errors of the mapping run that made it. Where the
+//! benchmark's files are missing, [`refine_relations`] refines the derived relations by
+//! aligning their two scans and keeps those whose alignment is unique and well constrained
+//! (its docs give the checks); [`explicit_relation_errors`] scores against them.
 
 use raypath_geometry::Pose2;
 use raypath_reflectivity::benchmark::{Stats, relation_error, relation_error_lists};
 use serde::{Deserialize, Serialize};
 
+mod refine;
 mod relation_file;
 
+pub use refine::{Dropped, RefineConfig, Refined, Refusal, refine, refine_relations};
 pub use relation_file::{
-    MatchedRelations, STAMP_TOLERANCE_SECS, file_relation_errors, match_relation_file,
-    relations_from_reference,
+    MatchedRelations, STAMP_TOLERANCE_SECS, explicit_relation_errors, file_relation_errors,
+    match_relation_file, relations_from_reference,
 };
 
 /// Mean and standard deviation of the relation errors: the JSON keys are a contract of

@@ -58,8 +58,18 @@ pub fn match_relation_file(ipc_stamps: &[Option<f64>], relations: &[Relation]) -
 /// for relation `(i, j, δ)`, the translation and angle of `δ⁻¹ (x_i⁻¹ x_j)` (Kümmerle et al.
 /// 2009, eq. 3 split into its parts), as [`super::relation_errors`] does for derived relations.
 pub fn file_relation_errors(estimate: &[Pose2], matched: &MatchedRelations) -> ErrorSummary {
+    explicit_relation_errors(estimate, &matched.relations)
+}
+
+/// Relation errors of `estimate` against relations that carry their own relative pose
+/// `(i, j, i_from_j)` (a relation file's, or [`super::refine_relations`]'); relations naming a
+/// scan the estimate does not have are skipped.
+pub fn explicit_relation_errors(
+    estimate: &[Pose2],
+    relations: &[(usize, usize, Pose2)],
+) -> ErrorSummary {
     let (mut t, mut r) = (Vec::new(), Vec::new());
-    for &(i, j, a_from_b) in &matched.relations {
+    for &(i, j, a_from_b) in relations {
         let (Some(a), Some(b)) = (estimate.get(i), estimate.get(j)) else {
             continue;
         };
