@@ -401,9 +401,7 @@ fn print(doc: &Value) {
     );
     println!(
         "map: {}",
-        doc["map"]["outputs"]["png"]
-            .as_str()
-            .unwrap_or("(see map.*)")
+        doc["map"]["files"]["png"].as_str().unwrap_or("(see map.*)")
     );
     if let Ok(s) = serde_json::from_value::<SummaryView>(doc["summary"].clone()) {
         println!(
