@@ -185,7 +185,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 &reference,
                 &consecutive_relations(&referenced),
                 &RefineConfig::default(),
-            );
+            )?;
             let moved = refined.corrections_m.iter().sum::<f64>()
                 / refined.corrections_m.len().max(1) as f64;
             println!(

@@ -122,22 +122,22 @@ struct Relations {
 }
 
 impl Relations {
-    fn of(frames: &[PlanarFrame]) -> Self {
+    fn of(frames: &[PlanarFrame]) -> Result<Self> {
         let truth: Vec<Option<Pose2>> = frames.iter().map(|f| f.reference).collect();
         let referenced: Vec<usize> = (0..frames.len()).filter(|&i| truth[i].is_some()).collect();
         let consecutive = consecutive_relations(&referenced);
         let scans: Vec<&raypath_geometry::Scan2> = frames.iter().map(|f| &f.scan).collect();
         let supported = scan_supported(&scans, &truth, &consecutive);
-        let refined = refine_relations(&scans, &truth, &consecutive, &RefineConfig::default());
+        let refined = refine_relations(&scans, &truth, &consecutive, &RefineConfig::default())?;
         let random = random_relations(&referenced, RANDOM_PAIRS, SEED);
-        Self {
+        Ok(Self {
             truth,
             consecutive,
             supported,
             refined,
             random,
             file: None,
-        }
+        })
     }
 }
 
@@ -304,7 +304,7 @@ fn referenced(ctx: &EvalContext, name: &str, raw: &str, corrected: &str) -> Resu
     let mut frames = read(ctx, raw, limit)?;
     let reference = read(ctx, corrected, None)?;
     pair_reference(&mut frames, &reference);
-    let mut relations = Relations::of(&frames);
+    let mut relations = Relations::of(&frames)?;
     relations.file = read_relation_file(ctx, name, &frames)?;
     let unmatched = relations.file.as_ref().map(|m| m.unmatched);
     let odometry: Vec<Pose2> = frames.iter().map(|f| f.world_from_laser).collect();
@@ -390,8 +390,8 @@ fn ablation(ctx: &EvalContext, world: &str) -> Result<Value> {
         frames.truncate(600);
     }
     pair_reference(&mut frames, &read_planar(&corrected, &options)?);
-    let relations = Relations::of(&frames);
-    let check = refinement::check(world, &frames, &relations);
+    let relations = Relations::of(&frames)?;
+    let check = refinement::check(world, &frames, &relations)?;
     let mut notes = Vec::new();
     let modes: &[ResidualMode] = if frames.iter().any(|f| f.scan.intensities.is_some()) {
         &[ResidualMode::Occupancy, ResidualMode::Combined]

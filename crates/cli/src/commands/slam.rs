@@ -306,7 +306,8 @@ fn evaluate(
         &truth,
         &consecutive_relations(&referenced),
         &RefineConfig::default(),
-    );
+    )
+    .map_err(Failure::internal)?;
     let moved =
         refined.corrections_m.iter().sum::<f64>() / refined.corrections_m.len().max(1) as f64;
     let disputed = raypath_slam::benchmark::wrong_at_disputed_reference(&checks, &scans, &truth);

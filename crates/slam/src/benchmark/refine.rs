@@ -69,6 +69,42 @@ impl Default for RefineConfig {
     }
 }
 
+impl RefineConfig {
+    /// Checks the settings: at least one gate, every value finite and positive (the minimum
+    /// constraint may be zero) and the iterations at least one.
+    pub fn validate(&self) -> crate::Result<()> {
+        use crate::error::require_positive;
+        if self.gates_m.is_empty() || self.iterations == 0 {
+            return Err(crate::SlamError::InvalidParameter {
+                name: "gates_m / iterations",
+                reason: "at least one gate and one iteration".into(),
+            });
+        }
+        for &gate in &self.gates_m {
+            require_positive("gates_m", gate)?;
+        }
+        for (name, value) in [
+            ("kernel_m", self.kernel_m),
+            ("restart_offset.0", self.restart_offset.0),
+            ("restart_offset.1", self.restart_offset.1),
+            ("agreement.0", self.agreement.0),
+            ("agreement.1", self.agreement.1),
+            ("max_correction.0", self.max_correction.0),
+            ("max_correction.1", self.max_correction.1),
+            ("normal_radius_m", self.normal_radius_m),
+        ] {
+            require_positive(name, value)?;
+        }
+        if !(0.0..=0.5).contains(&self.min_constraint) {
+            return Err(crate::SlamError::InvalidParameter {
+                name: "min_constraint",
+                reason: format!("must lie in [0, 0.5], got {}", self.min_constraint),
+            });
+        }
+        Ok(())
+    }
+}
+
 /// Why a relation was not refined.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Dropped {
@@ -97,14 +133,15 @@ pub struct Refined {
 }
 
 /// Refines the reference relations `pairs` of `scans` (reference poses `reference[k]` of scan
-/// `k`) by aligning the scans (module docs).
+/// `k`) by aligning the scans (module docs); an error only for invalid settings.
 pub fn refine_relations(
     scans: &[&Scan2],
     reference: &[Option<Pose2>],
     pairs: &[(usize, usize)],
     config: &RefineConfig,
-) -> Refined {
+) -> crate::Result<Refined> {
     use rayon::prelude::*;
+    config.validate()?;
     let results: Vec<Result<Pose2, Refusal>> = pairs
         .par_iter()
         .map(|&(i, j)| {
@@ -131,7 +168,7 @@ pub fn refine_relations(
             Err(reason) => *reason.counter(&mut out.dropped) += 1,
         }
     }
-    out
+    Ok(out)
 }
 
 /// Why [`refine`] refused.
@@ -169,6 +206,9 @@ pub fn refine(
     initial: Pose2,
     config: &RefineConfig,
 ) -> Result<Pose2, Refusal> {
+    if !initial.is_finite() {
+        return Err(Refusal::Unaligned);
+    }
     let target = Lines::new(near_points(scan_i, &Pose2::identity()).collect(), config);
     let source: Vec<Point2<f64>> = near_points(scan_j, &Pose2::identity()).collect();
     if target.points.len() < MIN_POINTS || source.len() < MIN_POINTS {
@@ -256,6 +296,9 @@ impl Lines {
                 let step = h.cholesky().ok_or(Refusal::Unaligned)?.solve(&(-g));
                 // A left increment: q ↦ R(δθ) q + δt in scan i's frame.
                 pose = Pose2::new(step.x, step.y, step.z) * pose;
+                if !pose.is_finite() {
+                    return Err(Refusal::Unaligned);
+                }
                 spread = smaller_share(&scatter);
                 if step.xy().norm() < 1e-6 && step.z.abs() < 1e-7 {
                     break;

@@ -41,14 +41,14 @@ pub(super) fn of_reference(log: &str, rel: &Relations) -> Value {
 
 /// On a simulated world: the refinement from the exact reference, and from the exact
 /// reference with [`CHECK_NOISE`] on every pose (seeded), each scored against the truth.
-pub(super) fn check(world: &str, frames: &[PlanarFrame], rel: &Relations) -> Value {
+pub(super) fn check(world: &str, frames: &[PlanarFrame], rel: &Relations) -> Result<Value> {
     let truth: Vec<Pose2> = rel.truth.iter().map(|p| p.unwrap_or_default()).collect();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(SEED);
     let (Ok(along), Ok(turn)) = (
         Normal::new(0.0, CHECK_NOISE.0),
         Normal::new(0.0, CHECK_NOISE.1.to_radians()),
     ) else {
-        return Value::Null;
+        anyhow::bail!("the check's noise must be finite and positive");
     };
     let noisy: Vec<Option<Pose2>> = rel
         .truth
@@ -64,8 +64,8 @@ pub(super) fn check(world: &str, frames: &[PlanarFrame], rel: &Relations) -> Val
         .collect();
     let noisy_poses: Vec<Pose2> = noisy.iter().map(|p| p.unwrap_or_default()).collect();
     let scans: Vec<&raypath_geometry::Scan2> = frames.iter().map(|f| &f.scan).collect();
-    let from_noisy = refine_relations(&scans, &noisy, &rel.consecutive, &RefineConfig::default());
-    json!({
+    let from_noisy = refine_relations(&scans, &noisy, &rel.consecutive, &RefineConfig::default())?;
+    Ok(json!({
         "world": world, "consecutive": rel.consecutive.len(),
         "noise_m": CHECK_NOISE.0, "noise_deg": CHECK_NOISE.1,
         "exact_kept": rel.refined.relations.len(),
@@ -73,7 +73,7 @@ pub(super) fn check(world: &str, frames: &[PlanarFrame], rel: &Relations) -> Val
         "noisy_reference_error": relation_errors(&rel.truth, &noisy_poses, &rel.consecutive),
         "noisy_kept": from_noisy.relations.len(),
         "noisy_refined_error": explicit_relation_errors(&truth, &from_noisy.relations),
-    })
+    }))
 }
 
 fn summary(v: &Value, key: &str) -> Result<ErrorSummary> {

@@ -127,7 +127,8 @@ fn relations_are_refined_or_counted() {
         &reference,
         &[(0, 1), (1, 2), (0, 7)],
         &RefineConfig::default(),
-    );
+    )
+    .unwrap();
     assert_eq!(out.dropped.unaligned, 2);
     assert_eq!(out.relations.len(), 1);
     let (i, j, rel) = out.relations[0];
@@ -165,4 +166,74 @@ fn noisy_scans_refine_to_millimetres() {
         worst = worst.max(off_by(truth, refined).0);
     }
     assert!(worst < 5e-3, "worst {worst} m");
+}
+
+/// Empty scans, no-return (NaN, infinite) ranges and a non-finite reference are refusals,
+/// never panics.
+#[test]
+fn bad_input_is_refused() {
+    let walls = room();
+    let good = scan_at(&walls, Pose2::new(0.0, -1.0, 0.0));
+    let empty = Scan2 {
+        ranges: Vec::new(),
+        ..good.clone()
+    };
+    let broken = Scan2 {
+        ranges: vec![f64::NAN, f64::INFINITY, -1.0, 0.0],
+        ..good.clone()
+    };
+    let config = RefineConfig::default();
+    for (a, b) in [
+        (&good, &empty),
+        (&empty, &good),
+        (&broken, &good),
+        (&good, &broken),
+    ] {
+        assert_eq!(
+            refine(a, b, Pose2::identity(), &config),
+            Err(Refusal::Unaligned)
+        );
+    }
+    let nan = Pose2::new(f64::NAN, 0.0, 0.0);
+    assert_eq!(refine(&good, &good, nan, &config), Err(Refusal::Unaligned));
+}
+
+/// Settings out of range are errors naming the field.
+#[test]
+fn bad_settings_are_errors() {
+    let ok = RefineConfig::default();
+    assert!(ok.validate().is_ok());
+    let cases = [
+        RefineConfig {
+            gates_m: vec![],
+            ..ok.clone()
+        },
+        RefineConfig {
+            gates_m: vec![0.3, f64::NAN],
+            ..ok.clone()
+        },
+        RefineConfig {
+            kernel_m: 0.0,
+            ..ok.clone()
+        },
+        RefineConfig {
+            max_correction: (0.2, -1.0),
+            ..ok.clone()
+        },
+        RefineConfig {
+            min_constraint: 0.7,
+            ..ok.clone()
+        },
+    ];
+    let names = [
+        "gates_m / iterations",
+        "gates_m",
+        "kernel_m",
+        "max_correction.1",
+        "min_constraint",
+    ];
+    for (config, name) in cases.iter().zip(names) {
+        let err = refine_relations(&[], &[], &[(0, 1)], config).unwrap_err();
+        assert!(err.to_string().contains(name), "{err}");
+    }
 }
