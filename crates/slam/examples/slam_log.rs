@@ -242,7 +242,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
             }
         }
-        let (checked, wrong, checks) = raypath_slam::benchmark::check_loops(&out, &reference, 50);
+        let all_scans: Vec<_> = frames.iter().map(|f| &f.scan).collect();
+        let (checked, wrong, checks) = raypath_slam::benchmark::check_loops(
+            &out,
+            &all_scans,
+            &reference,
+            50,
+            raypath_slam::benchmark::LoopPairing::Overlap,
+        );
+        let (_, wrong_nearest, _) = raypath_slam::benchmark::check_loops(
+            &out,
+            &all_scans,
+            &reference,
+            50,
+            raypath_slam::benchmark::LoopPairing::Nearest,
+        );
+        println!("loop closures against the nearest node: {wrong_nearest} wrong");
         println!("loop stats: {:?}", out.stats.loops);
         println!("loop closures: {wrong} of {checked} checked wrong");
         for cut in [0.3, 0.5, 0.7] {

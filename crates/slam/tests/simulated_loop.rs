@@ -3,7 +3,9 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // test code: a panic is the failure report
 
 use raypath_geometry::{Pose2, Scan2};
-use raypath_slam::benchmark::{loop_error, submap_disagreement};
+use raypath_slam::benchmark::{
+    LoopPairing, check_loops, loop_error, submap_disagreement, support_share,
+};
 use raypath_slam::{Slam, SlamConfig, SlamOutput};
 
 type Segment = ([f64; 2], [f64; 2]);
@@ -155,6 +157,53 @@ fn a_simulated_loop_is_closed_and_no_wrong_loop_is_accepted() {
         let (a, b) = (full.node_scan[c.anchor], full.node_scan[c.node]);
         let (t, r) = loop_error(Some(world(a)), Some(world(b)), c.submap_from_sensor).unwrap();
         assert!(t < 0.15 && r < 0.03, "loop {a} → {b}: {t} m, {r} rad");
+    }
+    check_against_references(&full, &truth);
+}
+
+/// `check_loops` with both pairings: no loop closure is wrong against the truth; against a
+/// reference that turns the second lap by 5°, the loop closures into the first lap are; the
+/// overlap pairing picks a node that shares at least as much with the loop's scan as the
+/// nearest node does.
+fn check_against_references(out: &SlamOutput, truth: &[Pose2]) {
+    let walls = walls();
+    let scans: Vec<Scan2> = truth.iter().map(|p| scan_at(*p, &walls)).collect();
+    let scans: Vec<&Scan2> = scans.iter().collect();
+    let exact: Vec<Option<Pose2>> = truth.iter().map(|p| Some(*p)).collect();
+    let lap = truth.len() / 2;
+    let turned: Vec<Option<Pose2>> = truth
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            Some(if k < lap {
+                *p
+            } else {
+                Pose2::new(0.0, 0.0, 0.087) * *p
+            })
+        })
+        .collect();
+    let share = |c: &raypath_slam::benchmark::LoopCheck| {
+        support_share(scans[c.near_scan], scans[c.scan], &c.reference()).unwrap_or(0.0)
+    };
+    let (_, _, nearest) = check_loops(out, &scans, &exact, 50, LoopPairing::Nearest);
+    for pairing in [LoopPairing::Overlap, LoopPairing::Nearest] {
+        let (checked, wrong, checks) = check_loops(out, &scans, &exact, 50, pairing);
+        assert_eq!(checked, out.loop_closures.len(), "{pairing:?}");
+        assert_eq!(wrong, 0, "{pairing:?}: {checks:?}");
+        if pairing == LoopPairing::Overlap {
+            for (o, n) in checks.iter().zip(&nearest) {
+                assert!(share(o) >= share(n), "{o:?} against {n:?}");
+            }
+        }
+        let (_, wrong, checks) = check_loops(out, &scans, &turned, 50, pairing);
+        let across = checks
+            .iter()
+            .filter(|c| c.near_scan < lap && c.scan >= lap)
+            .count();
+        assert!(
+            across > 0 && wrong >= across,
+            "{pairing:?}: {wrong} of {across}"
+        );
     }
 }
 

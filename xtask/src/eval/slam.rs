@@ -22,9 +22,9 @@ use raypath_io::sequence::{PlanarFrame, PlanarOptions, pair_reference, read_plan
 use raypath_reflectivity::benchmark::run_matcher;
 use raypath_reflectivity::{PointFilter, ResidualMode};
 use raypath_slam::benchmark::{
-    ErrorSummary, MatchedRelations, RefineConfig, Refined, check_loops, consecutive_relations,
-    explicit_relation_errors, file_relation_errors, match_relation_file, random_relations,
-    refine_relations, relation_errors, scan_supported, submap_disagreement,
+    ErrorSummary, LoopPairing, MatchedRelations, RefineConfig, Refined, check_loops,
+    consecutive_relations, explicit_relation_errors, file_relation_errors, match_relation_file,
+    random_relations, refine_relations, relation_errors, scan_supported, submap_disagreement,
 };
 use raypath_slam::graph::RobustKernel;
 use raypath_slam::{Slam, SlamConfig, SlamOutput};
@@ -78,6 +78,9 @@ struct Scored {
     loops: usize,
     rejected: usize,
     wrong: usize,
+    /// Wrong when each loop's scan is compared with the nearest node instead
+    /// ([`LoopPairing::Nearest`]).
+    wrong_nearest: usize,
     /// Of the wrong ones, those where the reference itself is disputed by the scans
     /// ([`raypath_slam::benchmark::LoopCheck::reference_disputed`]).
     disputed: usize,
@@ -176,12 +179,14 @@ fn score(
     let random = relation_errors(truth, poses, &rel.random);
     let benchmark = rel.file.as_ref().map(|m| file_relation_errors(poses, m));
     let (mut wrong, mut checked, mut loops, mut rejected, mut disputed) = (0, 0, 0, 0, 0);
+    let mut wrong_nearest = 0;
     if let Some(out) = out {
         loops = out.loop_closures.len();
         rejected = out.rejected_loop_closures.len();
         let checks;
-        (checked, wrong, checks) = check_loops(out, truth, 50);
         let scans: Vec<&raypath_geometry::Scan2> = frames.iter().map(|f| &f.scan).collect();
+        (checked, wrong, checks) = check_loops(out, &scans, truth, 50, LoopPairing::Overlap);
+        (_, wrong_nearest, _) = check_loops(out, &scans, truth, 50, LoopPairing::Nearest);
         disputed = raypath_slam::benchmark::wrong_at_disputed_reference(&checks, &scans, truth);
     }
     Scored {
@@ -192,6 +197,7 @@ fn score(
         loops,
         rejected,
         wrong,
+        wrong_nearest,
         disputed,
         checked,
         seconds,
@@ -212,6 +218,7 @@ fn row_json(log: &str, method: &str, s: &Scored) -> Value {
         "scan_supported": s.supported, "scan_refined": s.refined,
         "loop_closures": s.loops, "rejected_loop_closures": s.rejected,
         "wrong_loop_closures": s.wrong, "loop_closures_checked": s.checked,
+        "wrong_loop_closures_nearest_node": s.wrong_nearest,
         "wrong_loop_closures_reference_disputed": s.disputed,
         "benchmark_relations": s.benchmark,
         "seconds": s.seconds, "scans": s.scans, "scans_per_second": sps,

@@ -24,8 +24,11 @@
 //! 2009; scans paired with the corrected log by identical readings), `"random_pairs"` (the
 //! same over 1000 seeded random pairs) and `"wrong_loop_closures"` (accepted loop closures
 //! whose association error is above 0.3 m or 3°, `raypath_slam::benchmark::check_loops`, of
-//! `"loop_closures_checked"`; `"wrong_loop_closures_reference_disputed"` counts those of
-//! them where the corrected log disagrees with its own scans, `LoopCheck::reference_disputed`).
+//! `"loop_closures_checked"`: the loop's scan against the node of the matched submap whose
+//! scan overlaps it most at the reference poses; `"wrong_loop_closures_nearest_node"` counts
+//! the same against the node nearest to where the loop placed the scan;
+//! `"wrong_loop_closures_reference_disputed"` counts those wrong ones where the corrected log
+//! disagrees with its own scans, `LoopCheck::reference_disputed`).
 //! `"scan_refined": {"summary", "dropped", "reference_moved_m"}` scores the consecutive
 //! relations refined by aligning their two scans and kept where that alignment is unique and
 //! well constrained (`raypath_slam::benchmark::refine_relations`; `dropped` counts the others
@@ -48,7 +51,7 @@ use raypath_io::sequence::{PlanarFrame, pair_reference};
 use raypath_reflectivity::ResidualMode;
 use raypath_sensor_models::export::{MapFile, StoredStats};
 use raypath_slam::benchmark::{
-    RefineConfig, check_loops, consecutive_relations, explicit_relation_errors,
+    LoopPairing, RefineConfig, check_loops, consecutive_relations, explicit_relation_errors,
     file_relation_errors, match_relation_file, random_relations, refine_relations, relation_errors,
 };
 use raypath_slam::{Slam, SlamConfig, SlamOutput};
@@ -299,8 +302,11 @@ fn evaluate(
         &out.world_from_sensor,
         &random_relations(&referenced, 1000, 1),
     );
-    let (checked, wrong, checks) = check_loops(out, &truth, NEIGHBOUR_GAP);
     let scans: Vec<_> = frames.iter().map(|f| &f.scan).collect();
+    let (checked, wrong, checks) =
+        check_loops(out, &scans, &truth, NEIGHBOUR_GAP, LoopPairing::Overlap);
+    let (_, wrong_nearest, _) =
+        check_loops(out, &scans, &truth, NEIGHBOUR_GAP, LoopPairing::Nearest);
     let refined = refine_relations(
         &scans,
         &truth,
@@ -322,6 +328,7 @@ fn evaluate(
         },
         "loop_closures_checked": checked,
         "wrong_loop_closures": wrong,
+        "wrong_loop_closures_nearest_node": wrong_nearest,
         "wrong_loop_closures_reference_disputed": disputed,
     }))
 }

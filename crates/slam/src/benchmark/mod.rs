@@ -27,9 +27,14 @@ use raypath_geometry::Pose2;
 use raypath_reflectivity::benchmark::{Stats, relation_error, relation_error_lists};
 use serde::{Deserialize, Serialize};
 
+mod loop_check;
 mod refine;
 mod relation_file;
 
+pub use loop_check::{
+    DISPUTE_GAP, LoopCheck, LoopPairing, WRONG_LOOP_DEG, WRONG_LOOP_M, check_loops,
+    reference_by_neighbour, reference_support, wrong_at_disputed_reference,
+};
 pub use refine::{Dropped, RefineConfig, Refined, Refusal, refine, refine_relations};
 pub use relation_file::{
     MatchedRelations, STAMP_TOLERANCE_SECS, explicit_relation_errors, file_relation_errors,
@@ -238,170 +243,6 @@ impl PointIndex {
     }
 }
 
-/// A loop closure is wrong when its association error exceeds this, metres …
-pub const WRONG_LOOP_M: f64 = 0.3;
-/// … or this, degrees.
-pub const WRONG_LOOP_DEG: f64 = 3.0;
-
-/// Checks every accepted loop closure of `output` against `reference` (per scan; `None` where
-/// a scan has none): the **association error** of a loop closure is the error of the relative
-/// pose between its node and the submap node nearest to where it was matched (the front-end's
-/// pose of that node in the submap, composed with the loop's `submap_from_sensor`), against
-/// the reference. It says whether the scan was placed at the right spot of the submap; the
-/// anchor-to-node relation would also charge the loop for the submap's own bending over its
-/// length, which the intra-submap constraints carry. Scans without a reference borrow one
-/// from the nearest referenced scan within `max_gap` scans ([`reference_by_neighbour`]).
-/// Returns `(checked, wrong, checks)` with one [`LoopCheck`] per checked loop closure.
-pub fn check_loops(
-    output: &crate::SlamOutput,
-    reference: &[Option<Pose2>],
-    max_gap: usize,
-) -> (usize, usize, Vec<LoopCheck>) {
-    let local: Vec<Pose2> = output.scans.iter().map(|s| s.local).collect();
-    let near = reference_by_neighbour(reference, &local, max_gap);
-    let node_local = |n: usize| output.node_scan.get(n).and_then(|&k| local.get(k)).copied();
-    let mut checks = Vec::new();
-    for (closure, c) in output.loop_closures.iter().enumerate() {
-        let (Some(submap), Some(anchor_local), Some(&scan)) = (
-            output.submaps.get(c.submap),
-            node_local(c.anchor),
-            output.node_scan.get(c.node),
-        ) else {
-            continue;
-        };
-        // The submap node nearest to the matched position.
-        let Some((k, submap_from_k)) = submap
-            .nodes()
-            .iter()
-            .filter_map(|&k| Some((k, anchor_local.inverse() * node_local(k)?)))
-            .min_by(|a, b| {
-                let d = |p: &Pose2| (p.translation() - c.submap_from_sensor.translation()).norm();
-                d(&a.1).total_cmp(&d(&b.1))
-            })
-        else {
-            continue;
-        };
-        let Some(&k_scan) = output.node_scan.get(k) else {
-            continue;
-        };
-        let measured = submap_from_k.inverse() * c.submap_from_sensor;
-        let (reference_near, reference_scan) = (
-            near.get(k_scan).copied().flatten(),
-            near.get(scan).copied().flatten(),
-        );
-        if let (Some((trans_m, rot_rad)), Some(a), Some(b)) = (
-            loop_error(reference_near, reference_scan, measured),
-            reference_near,
-            reference_scan,
-        ) {
-            checks.push(LoopCheck {
-                closure,
-                near_scan: k_scan,
-                scan,
-                measured,
-                reference_near: a,
-                reference_scan: b,
-                trans_m,
-                rot_rad,
-            });
-        }
-    }
-    let wrong = checks.iter().filter(|c| c.is_wrong()).count();
-    (checks.len(), wrong, checks)
-}
-
-/// One loop closure checked against the reference by [`check_loops`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LoopCheck {
-    /// Index into [`crate::SlamOutput::loop_closures`].
-    pub closure: usize,
-    /// The scan of the submap node nearest to where the loop closure placed its scan.
-    pub near_scan: usize,
-    /// The scan the loop closure placed.
-    pub scan: usize,
-    /// The loop closure's relative pose `near_scan ← scan`.
-    pub measured: Pose2,
-    /// The reference pose of `near_scan` (borrowed by neighbour where the scan has no
-    /// reference of its own).
-    pub reference_near: Pose2,
-    /// The reference pose of `scan` (borrowed likewise).
-    pub reference_scan: Pose2,
-    /// Association error: translation, metres.
-    pub trans_m: f64,
-    /// Association error: absolute angle, radians.
-    pub rot_rad: f64,
-}
-
-impl LoopCheck {
-    /// Above [`WRONG_LOOP_M`] or [`WRONG_LOOP_DEG`].
-    pub fn is_wrong(&self) -> bool {
-        self.trans_m > WRONG_LOOP_M || self.rot_rad.to_degrees() > WRONG_LOOP_DEG
-    }
-
-    /// The reference's relative pose `near_scan ← scan`.
-    pub fn reference(&self) -> Pose2 {
-        self.reference_near.inverse() * self.reference_scan
-    }
-
-    /// Whether the reference itself is in doubt at this loop closure: one of its two scans,
-    /// placed at its reference pose, has less than half of its points (within
-    /// [`SUPPORT_RANGE_M`]) within [`SUPPORT_TOLERANCE_M`] of the points of the referenced
-    /// scans more than [`DISPUTE_GAP`] scans away, placed at theirs ([`reference_support`]).
-    /// A corrected log can be wrong at single scans; an association error measured against
-    /// such a reference says nothing about the loop closure. Reported beside the wrong
-    /// count, never instead of it.
-    pub fn reference_disputed(
-        &self,
-        scans: &[&raypath_geometry::Scan2],
-        reference: &[Option<Pose2>],
-    ) -> bool {
-        [
-            (self.near_scan, self.reference_near),
-            (self.scan, self.reference_scan),
-        ]
-        .into_iter()
-        .any(|(i, pose)| reference_support(scans, reference, i, &pose).is_some_and(|s| s < 0.5))
-    }
-}
-
-/// How many of `checks` are wrong at a disputed reference
-/// ([`LoopCheck::reference_disputed`]).
-pub fn wrong_at_disputed_reference(
-    checks: &[LoopCheck],
-    scans: &[&raypath_geometry::Scan2],
-    reference: &[Option<Pose2>],
-) -> usize {
-    checks
-        .iter()
-        .filter(|c| c.is_wrong() && c.reference_disputed(scans, reference))
-        .count()
-}
-
-/// Scans closer than this (by index) to the scan under test are left out of the map that
-/// [`reference_support`] checks it against: 30, a few metres of travel in the logs we read.
-pub const DISPUTE_GAP: usize = 30;
-
-/// The share of scan `i`'s points (within [`SUPPORT_RANGE_M`]), placed at `pose`, within
-/// [`SUPPORT_TOLERANCE_M`] of the points of every referenced scan more than [`DISPUTE_GAP`]
-/// scans from `i`, placed at its reference pose; `None` without points.
-pub fn reference_support(
-    scans: &[&raypath_geometry::Scan2],
-    reference: &[Option<Pose2>],
-    i: usize,
-    pose: &Pose2,
-) -> Option<f64> {
-    let map = PointIndex::new(
-        scans
-            .iter()
-            .zip(reference)
-            .enumerate()
-            .filter(|(m, _)| m.abs_diff(i) > DISPUTE_GAP)
-            .filter_map(|(_, (scan, r))| Some(near_points(scan, r.as_ref()?).collect::<Vec<_>>()))
-            .flatten(),
-    );
-    map.share(near_points(scans.get(i)?, pose))
-}
-
 /// Self-consistency of a map without reference poses: of the confidently occupied cells of
 /// each finished submap (log-odds > 2, finest level) that fall, at the optimised submap poses,
 /// on confidently observed cells of another submap that shares no node with it, the fraction
@@ -483,31 +324,6 @@ fn occupied_near(
     (j.saturating_sub(near)..=(j + near).min(h - 1)).any(|y| {
         (i.saturating_sub(near)..=(i + near).min(w - 1)).any(|x| level.log_odds(x, y) > confident)
     })
-}
-
-/// For scans without a reference pose, a reference **by neighbour**: the nearest referenced
-/// scan (by index, at most `max_gap` scans away) composed with the front-end's relative
-/// motion to it (`local`: the front-end's poses, accurate over a few scans). Used to check
-/// loop closures whose scans are not in the corrected log.
-pub fn reference_by_neighbour(
-    reference: &[Option<Pose2>],
-    local: &[Pose2],
-    max_gap: usize,
-) -> Vec<Option<Pose2>> {
-    let n = reference.len().min(local.len());
-    (0..n)
-        .map(|k| {
-            if let Some(r) = reference[k] {
-                return Some(r);
-            }
-            let lo = k.saturating_sub(max_gap);
-            let hi = (k + max_gap).min(n - 1);
-            let nearest = (lo..=hi)
-                .filter(|&m| reference[m].is_some())
-                .min_by_key(|&m| m.abs_diff(k))?;
-            Some(reference[nearest]? * (local[nearest].inverse() * local[k]))
-        })
-        .collect()
 }
 
 #[cfg(test)]

@@ -55,10 +55,11 @@ fn table_row(v: &Value) -> Result<Vec<String>> {
     );
     let seconds = v["seconds"].as_f64().unwrap_or(0.0);
     let sps = v["scans_per_second"].as_f64().unwrap_or(f64::NAN);
-    let (wrong, checked, disputed) = (
+    let (wrong, checked, disputed, nearest) = (
         count(v, "wrong_loop_closures")?,
         count(v, "loop_closures_checked")?,
         count(v, "wrong_loop_closures_reference_disputed")?,
+        count(v, "wrong_loop_closures_nearest_node")?,
     );
     Ok(vec![
         v["log"].as_str().unwrap_or_default().to_string(),
@@ -84,10 +85,12 @@ fn table_row(v: &Value) -> Result<Vec<String>> {
             count(v, "loop_closures")?,
             count(v, "rejected_loop_closures")?
         ),
-        if disputed > 0 {
-            format!("{wrong} of {checked} ({disputed} at a disputed reference)")
-        } else {
-            format!("{wrong} of {checked}")
+        match (disputed, checked) {
+            (_, 0) => "0 of 0".into(),
+            (0, _) => format!("{wrong} of {checked} (nearest node: {nearest})"),
+            _ => format!(
+                "{wrong} of {checked} ({disputed} at a disputed reference; nearest node: {nearest})"
+            ),
         },
         if seconds > 0.0 {
             fmt_num(seconds, 1)
@@ -219,11 +222,18 @@ pub(super) fn report(ctx: &EvalContext, results: &UnitResults) -> Result<EvalRep
          and says how many of all it kept. It also drops relations between scans that barely \
          overlap, so it is shown beside the full set, not instead of it. A loop closure \
          is counted wrong when its **association error** is above 0.3 m or 3°: the relative \
-         pose between the loop's scan and the submap node nearest to where it was matched, \
-         against the reference (scans without a reference use the nearest referenced scan \
-         within 50 scans, moved by the front-end's motion). It tells a false association from \
-         a right one; the anchor-to-node relation would also charge the submap's own bending \
-         (an earlier run of this report used it and counted 12 of 858 Intel loops wrong). A \
+         pose between the loop's scan and the node of the matched submap whose scan shares the \
+         most with it at their reference poses (`LoopPairing::Overlap`; chosen from the \
+         reference and the scans, never the estimate), against the reference (scans without a \
+         reference use the nearest referenced scan within 50 scans, moved by the front-end's \
+         motion). Two scans that see the same walls are related by the corrected log as \
+         tightly as it was matched; the node nearest to where the loop placed its scan may face \
+         the other way and share little, and then the reference relates the two only through \
+         the corrected log's path between them. The count against that nearest node, which \
+         earlier runs of this report used, stands in brackets. It tells a false association \
+         from a right one; the anchor-to-node relation would also charge the submap's own \
+         bending (an earlier run of this report used it and counted 12 of 858 Intel loops \
+         wrong). A \
          wrong loop is marked **at a disputed reference** when one of its two scans, placed at \
          its reference pose, has less than half of its points (within 10 m) within 0.1 m of the \
          referenced scans more than 30 scans away (`LoopCheck::reference_disputed`): there the \
@@ -432,6 +442,7 @@ mod tests {
             loops: 12,
             rejected: 3,
             wrong: 2,
+            wrong_nearest: 3,
             disputed: 1,
             checked: 11,
             seconds: 2.0,
@@ -452,7 +463,10 @@ mod tests {
         assert_eq!(cells[6], "0.0200 ± 0.0100 (97 of 100)");
         assert_eq!(cells[7], "0.0100 ± 0.0050 (80 of 100)");
         assert_eq!(cells[9], "12 / 3");
-        assert_eq!(cells[10], "2 of 11 (1 at a disputed reference)");
+        assert_eq!(
+            cells[10],
+            "2 of 11 (1 at a disputed reference; nearest node: 3)"
+        );
         assert_eq!(cells[12], "250");
         let mut page = String::new();
         published(&mut page, &[json]).unwrap();
@@ -481,6 +495,7 @@ mod tests {
             loops: 12,
             rejected: 3,
             wrong: 0,
+            wrong_nearest: 1,
             disputed: 0,
             checked: 11,
             seconds: 2.0,
