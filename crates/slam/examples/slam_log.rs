@@ -46,7 +46,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // (σ_t of loop edges), SLAM_EVERY (loop search every n nodes), SLAM_NODES (per submap),
     // SLAM_ITER (finest-level iterations), SLAM_LEVELS, SLAM_FREE / SLAM_OCC (update factors),
     // SLAM_NODE_DIST (node spacing), SLAM_RANGE (max range); SLAM_WRITE_RELATIONS=FILE writes
-    // the consecutive reference relations as a benchmark relation file.
+    // the consecutive reference relations as a benchmark relation file; SLAM_AMBIG (rotation
+    // ambiguity ratio, 0 = off), SLAM_AMBIG_DEG, SLAM_AMBIG_SHIFT (translation ambiguity, m).
     let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
     if let Some(r) = env("SLAM_RES") {
         config.matcher.map.finest_resolution_m = r;
@@ -111,6 +112,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if let Some(d) = env("SLAM_AMBIG_DEG") {
             l.ambiguity_min_angle_rad = d.to_radians();
         }
+    }
+    if let (Some(d), Some(l)) = (env("SLAM_AMBIG_SHIFT"), config.loops.as_mut()) {
+        l.ambiguity_min_shift_m = (d > 0.0).then_some(d);
     }
     let t0 = Instant::now();
     let mut slam = Slam::new(config)?;

@@ -55,7 +55,9 @@
 //!   place-recognition candidate over ±π; minimum branch-and-bound score 0.55 (Hess et al.'s
 //!   Cartographer default). A match is refused when another heading at least 3° away reaches
 //!   90 % of its score ([`LoopSearchConfig::ambiguity_ratio`]): the one Intel loop closure
-//!   that passed everything else while 8.9° off the corrected log was such a match.
+//!   that passed everything else while 8.9° off the corrected log was such a match. Likewise
+//!   when a pose at least 0.3 m away at the same heading does
+//!   ([`LoopSearchConfig::ambiguity_min_shift_m`]): a corridor without features along it.
 //! * Constraint σ: sequential and intra-submap (0.02 m, 0.5°), loop (0.05 m, 1°).
 //!
 //! ## Results (`cargo xtask eval slam`, docs/results/slam.md)

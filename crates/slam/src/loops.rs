@@ -162,7 +162,7 @@ impl LoopCloser {
                 continue;
             };
             self.stats.matched += 1;
-            if self.rotation_ambiguous(submap, &c, &m) {
+            if self.rotation_ambiguous(submap, &c, &m) || self.translation_ambiguous(submap, &m) {
                 self.stats.ambiguous_rejected += 1;
                 continue;
             }
@@ -218,6 +218,51 @@ impl LoopCloser {
             )
             .is_some()
         })
+    }
+
+    /// Whether a pose at least `ambiguity_min_shift_m` away from the match `m` (at its
+    /// heading, ± the rotation band) scores nearly as well: eight more branch-and-bound
+    /// searches over squares of that half-width around the match's, with `ambiguity_ratio` of
+    /// its score as their minimum. A corridor without features along it is such a place.
+    fn translation_ambiguous(
+        &self,
+        submap: &Submap,
+        m: &crate::correlative::CorrelativeMatch,
+    ) -> bool {
+        let (Some(ratio), Some(shift)) = (
+            self.config.ambiguity_ratio,
+            self.config.ambiguity_min_shift_m,
+        ) else {
+            return false;
+        };
+        let config = crate::correlative::CorrelativeConfig {
+            min_score: ratio * m.score,
+            ..self.config.correlative
+        };
+        let window = SearchWindow {
+            linear_m: shift,
+            angular_rad: self.config.ambiguity_min_angle_rad,
+        };
+        let at = m.submap_from_sensor;
+        (-1..=1)
+            .flat_map(|i| (-1..=1).map(move |j| (i, j)))
+            .filter(|&ij| ij != (0, 0))
+            .any(|(i, j)| {
+                let offset = 2.0 * shift;
+                let initial = Pose2::new(
+                    at.x() + f64::from(i) * offset,
+                    at.y() + f64::from(j) * offset,
+                    at.theta(),
+                );
+                match_scan(
+                    submap.precomputed(),
+                    &self.thinned,
+                    initial,
+                    &window,
+                    &config,
+                )
+                .is_some()
+            })
     }
 
     fn candidates(
@@ -371,8 +416,9 @@ mod tests {
         (active.freeze(7).unwrap(), raw)
     }
 
-    /// Whether the loop closer calls the match of the room's own scan ambiguous.
-    fn ambiguous(walls: &[([f64; 2], [f64; 2])]) -> bool {
+    /// Whether the loop closer calls the match of the room's own scan ambiguous: (in
+    /// rotation, in translation).
+    fn ambiguous(walls: &[([f64; 2], [f64; 2])]) -> (bool, bool) {
         let (submap, raw) = room_submap(walls);
         let config = LoopSearchConfig::default();
         let mut closer = LoopCloser::new(config, 30.0).unwrap();
@@ -395,11 +441,15 @@ mod tests {
         )
         .expect("the room's own scan matches");
         assert!(m.submap_from_sensor.translation().norm() < 0.06);
-        closer.rotation_ambiguous(&submap, &candidate, &m)
+        (
+            closer.rotation_ambiguous(&submap, &candidate, &m),
+            closer.translation_ambiguous(&submap, &m),
+        )
     }
 
     #[test]
-    fn a_round_room_is_ambiguous_in_rotation_a_square_one_with_a_corner_is_not() {
+    fn a_round_room_is_ambiguous_in_rotation_a_corridor_in_translation_a_room_with_a_pillar_in_neither()
+     {
         let polygon = |n: usize, r: f64| -> Vec<([f64; 2], [f64; 2])> {
             (0..n)
                 .map(|k| {
@@ -412,7 +462,10 @@ mod tests {
                 .collect()
         };
         // A 90-gon of radius 4 m looks the same every 4°.
-        assert!(ambiguous(&polygon(90, 4.0)));
+        assert_eq!(ambiguous(&polygon(90, 4.0)), (true, false));
+        // A featureless corridor, 16 m long and 2 m wide, looks the same along its length.
+        let corridor = [([-8.0, -1.0], [8.0, -1.0]), ([-8.0, 1.0], [8.0, 1.0])];
+        assert!(ambiguous(&corridor).1);
         // A 6 m × 4 m room with a pillar off the centre.
         let mut room = vec![
             ([-3.0, -2.0], [3.0, -2.0]),
@@ -426,7 +479,7 @@ mod tests {
             ([1.6, 1.0], [1.0, 1.0]),
             ([1.0, 1.0], [1.0, 0.5]),
         ]);
-        assert!(!ambiguous(&room));
+        assert_eq!(ambiguous(&room), (false, false));
     }
 
     #[test]

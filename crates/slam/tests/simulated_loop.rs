@@ -236,6 +236,12 @@ fn bad_scans_are_errors_not_panics() {
         let err = Slam::new(config).unwrap_err().to_string();
         assert!(err.contains("ambiguity"), "{err}");
     }
+    for shift in [0.0, -0.3, f64::INFINITY] {
+        let mut config = SlamConfig::default();
+        config.loops.as_mut().unwrap().ambiguity_min_shift_m = Some(shift);
+        let err = Slam::new(config).unwrap_err().to_string();
+        assert!(err.contains("ambiguity_min_shift_m"), "{err}");
+    }
 }
 
 /// Jumps in the odometry (as the raw MIT CSAIL log has: 0.5–0.9 m and 30–50° between two
