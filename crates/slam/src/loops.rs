@@ -198,10 +198,6 @@ impl LoopCloser {
         if half <= 0.0 {
             return false;
         }
-        let config = crate::correlative::CorrelativeConfig {
-            min_score: ratio * m.score,
-            ..self.config.correlative
-        };
         let theta = m.submap_from_sensor.theta();
         [1.0, -1.0].into_iter().any(|sign| {
             let initial = Pose2::new(c.initial.x(), c.initial.y(), theta + sign * (band + half));
@@ -209,15 +205,31 @@ impl LoopCloser {
                 linear_m: c.window.linear_m,
                 angular_rad: half,
             };
-            match_scan(
-                submap.precomputed(),
-                &self.thinned,
-                initial,
-                &window,
-                &config,
-            )
-            .is_some()
+            self.matches(submap, initial, &window, ratio * m.score)
         })
+    }
+
+    /// Whether branch and bound finds a pose within `window` around `initial` that scores at
+    /// least `min_score`.
+    fn matches(
+        &self,
+        submap: &Submap,
+        initial: Pose2,
+        window: &SearchWindow,
+        min_score: f64,
+    ) -> bool {
+        let config = crate::correlative::CorrelativeConfig {
+            min_score,
+            ..self.config.correlative
+        };
+        match_scan(
+            submap.precomputed(),
+            &self.thinned,
+            initial,
+            window,
+            &config,
+        )
+        .is_some()
     }
 
     /// Whether a pose at least `ambiguity_min_shift_m` away from the match `m` (at its
@@ -235,10 +247,6 @@ impl LoopCloser {
         ) else {
             return false;
         };
-        let config = crate::correlative::CorrelativeConfig {
-            min_score: ratio * m.score,
-            ..self.config.correlative
-        };
         let window = SearchWindow {
             linear_m: shift,
             angular_rad: self.config.ambiguity_min_angle_rad,
@@ -254,14 +262,7 @@ impl LoopCloser {
                     at.y() + f64::from(j) * offset,
                     at.theta(),
                 );
-                match_scan(
-                    submap.precomputed(),
-                    &self.thinned,
-                    initial,
-                    &window,
-                    &config,
-                )
-                .is_some()
+                self.matches(submap, initial, &window, ratio * m.score)
             })
     }
 

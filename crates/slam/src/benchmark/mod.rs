@@ -154,18 +154,27 @@ pub fn scan_supported(
     relations
         .iter()
         .copied()
-        .filter(|&(i, j)| {
-            let (Some(Some(xi)), Some(Some(xj)), Some(si), Some(sj)) = (
-                reference.get(i),
-                reference.get(j),
-                scans.get(i),
-                scans.get(j),
-            ) else {
-                return false;
-            };
-            support_share(si, sj, &(xi.inverse() * *xj)).is_some_and(|s| s >= 0.5)
+        .filter(|&pair| {
+            reference_pair(scans, reference, pair)
+                .and_then(|(si, sj, i_from_j)| support_share(si, sj, &i_from_j))
+                .is_some_and(|s| s >= 0.5)
         })
         .collect()
+}
+
+/// The two scans of the relation `(i, j)` and their reference relative pose `i_from_j`;
+/// `None` when a scan or a reference pose is missing.
+fn reference_pair<'a>(
+    scans: &[&'a raypath_geometry::Scan2],
+    reference: &[Option<Pose2>],
+    (i, j): (usize, usize),
+) -> Option<(
+    &'a raypath_geometry::Scan2,
+    &'a raypath_geometry::Scan2,
+    Pose2,
+)> {
+    let (xi, xj) = ((*reference.get(i)?)?, (*reference.get(j)?)?);
+    Some((scans.get(i)?, scans.get(j)?, xi.inverse() * xj))
 }
 
 /// The share of scan `j`'s points (within [`SUPPORT_RANGE_M`] of its sensor) that the

@@ -31,7 +31,7 @@ use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use nalgebra::{Matrix2, Matrix3, Point2, Vector2, Vector3};
 use raypath_geometry::{Pose2, Scan2};
 
-use super::near_points;
+use super::{near_points, reference_pair};
 
 /// Settings of [`refine_relations`]; the defaults are ours (module docs).
 #[derive(Clone, Debug, PartialEq)]
@@ -144,16 +144,10 @@ pub fn refine_relations(
     config.validate()?;
     let results: Vec<Result<Pose2, Refusal>> = pairs
         .par_iter()
-        .map(|&(i, j)| {
-            let (Some(Some(xi)), Some(Some(xj)), Some(si), Some(sj)) = (
-                reference.get(i),
-                reference.get(j),
-                scans.get(i),
-                scans.get(j),
-            ) else {
-                return Err(Refusal::Unaligned);
-            };
-            refine(si, sj, xi.inverse() * *xj, config)
+        .map(|&pair| {
+            let (si, sj, i_from_j) =
+                reference_pair(scans, reference, pair).ok_or(Refusal::Unaligned)?;
+            refine(si, sj, i_from_j, config)
         })
         .collect();
     let mut out = Refined::default();
