@@ -154,13 +154,19 @@ impl LoopCheck {
     /// A corrected log can be wrong at single scans; an association error measured against
     /// such a reference says nothing about the loop closure. Reported beside the wrong
     /// count, never instead of it.
+    ///
+    /// The reference is also in doubt where its own path near either scan is refuted by the
+    /// scans ([`reference_refuted_near`]).
     pub fn reference_disputed(&self, scans: &[&Scan2], reference: &[Option<Pose2>]) -> bool {
         [
             (self.near_scan, self.reference_near),
             (self.scan, self.reference_scan),
         ]
         .into_iter()
-        .any(|(i, pose)| reference_support(scans, reference, i, &pose).is_some_and(|s| s < 0.5))
+        .any(|(i, pose)| {
+            reference_support(scans, reference, i, &pose).is_some_and(|s| s < 0.5)
+                || reference_refuted_near(scans, reference, i)
+        })
     }
 }
 
@@ -184,6 +190,7 @@ pub const DISPUTE_GAP: usize = 30;
 /// The share of scan `i`'s points (within [`SUPPORT_RANGE_M`]), placed at `pose`, within
 /// [`SUPPORT_TOLERANCE_M`] of the points of every referenced scan more than [`DISPUTE_GAP`]
 /// scans from `i`, placed at its reference pose; `None` without points.
+/// See [`reference_refuted_near`] for the other ground of a dispute.
 pub fn reference_support(
     scans: &[&Scan2],
     reference: &[Option<Pose2>],
@@ -225,4 +232,46 @@ pub fn reference_by_neighbour(
             Some(reference[nearest]? * (local[nearest].inverse() * local[k]))
         })
         .collect()
+}
+
+/// Referenced scans on each side of a scan whose consecutive reference relations
+/// [`reference_refuted_near`] checks: 3.
+pub const REFUTE_SPAN: usize = 3;
+
+/// Whether the reference's own path near scan `k` is refuted by its scans: among the
+/// consecutive relations of the [`REFUTE_SPAN`] referenced scans before and after `k` (and `k`
+/// itself when referenced), one whose reference lays less than half of its second scan on
+/// the first (as [`super::scan_supported`]) while aligning the two scans from it
+/// ([`super::refine`], corrections up to 1 m and 30°) reaches a relation that does, more than
+/// [`WRONG_LOOP_M`] or [`WRONG_LOOP_DEG`] away. A corrected log that turns a run of scans
+/// against the scans' own alignment and turns back later is such a place (the corrected MIT
+/// CSAIL log does at scans 1887–1898); a loop closure checked there is measured against the
+/// excursion. Looks at the reference and the scans only, never at an estimate.
+pub fn reference_refuted_near(scans: &[&Scan2], reference: &[Option<Pose2>], k: usize) -> bool {
+    let referenced = |range: &mut dyn Iterator<Item = usize>| -> Vec<usize> {
+        range
+            .filter(|&m| reference.get(m).is_some_and(Option::is_some))
+            .take(REFUTE_SPAN)
+            .collect()
+    };
+    let mut run = referenced(&mut (0..k).rev());
+    run.reverse();
+    run.extend(referenced(&mut (k..reference.len())));
+    let wide = super::RefineConfig {
+        max_correction: (1.0, 30f64.to_radians()),
+        ..super::RefineConfig::default()
+    };
+    run.windows(2).any(|w| {
+        let Some((si, sj, i_from_j)) = super::reference_pair(scans, reference, (w[0], w[1])) else {
+            return false;
+        };
+        if support_share(si, sj, &i_from_j).is_none_or(|s| s >= 0.5) {
+            return false;
+        }
+        super::refine(si, sj, i_from_j, &wide).is_ok_and(|aligned| {
+            let (t, r) =
+                super::relation_error(&Pose2::identity(), &i_from_j, &Pose2::identity(), &aligned);
+            t > WRONG_LOOP_M || r.abs().to_degrees() > WRONG_LOOP_DEG
+        })
+    })
 }

@@ -32,8 +32,8 @@ mod refine;
 mod relation_file;
 
 pub use loop_check::{
-    DISPUTE_GAP, LoopCheck, LoopPairing, WRONG_LOOP_DEG, WRONG_LOOP_M, check_loops,
-    reference_by_neighbour, reference_support, wrong_at_disputed_reference,
+    DISPUTE_GAP, LoopCheck, LoopPairing, REFUTE_SPAN, WRONG_LOOP_DEG, WRONG_LOOP_M, check_loops,
+    reference_by_neighbour, reference_refuted_near, reference_support, wrong_at_disputed_reference,
 };
 pub use refine::{Dropped, RefineConfig, Refined, Refusal, refine, refine_relations};
 pub use relation_file::{
@@ -445,6 +445,33 @@ mod tests {
         };
         reference[40] = Some(poses[40]);
         assert!(!undisputed.reference_disputed(&refs, &reference));
+    }
+
+    /// A reference that turns a run of scans by 12° against their own alignment and turns
+    /// back later is refuted near the run, not far from it, and never where it is exact.
+    #[test]
+    fn a_reference_excursion_is_refuted_by_the_scans() {
+        use raypath_geometry::Scan2;
+        // 16 scans spinning through the room, 0.1 m and 0.4 rad apart; every other one
+        // referenced, as in a corrected log.
+        let poses: Vec<Pose2> = (0..16)
+            .map(|k| Pose2::new(-1.0 + 0.1 * k as f64, 0.1, 0.4 * k as f64))
+            .collect();
+        let scans = room_scans(&poses);
+        let refs: Vec<&Scan2> = scans.iter().collect();
+        let exact: Vec<Option<Pose2>> = poses
+            .iter()
+            .enumerate()
+            .map(|(k, p)| (k % 2 == 0).then_some(*p))
+            .collect();
+        assert!((0..16).all(|k| !reference_refuted_near(&refs, &exact, k)));
+        let mut excursion = exact.clone();
+        for r in excursion.iter_mut().take(10).skip(6).flatten() {
+            *r = *r * Pose2::new(0.0, 0.0, 0.21);
+        }
+        assert!(reference_refuted_near(&refs, &excursion, 7));
+        assert!(reference_refuted_near(&refs, &excursion, 10));
+        assert!(!reference_refuted_near(&refs, &excursion, 0));
     }
 
     #[test]

@@ -236,7 +236,11 @@ pub(super) fn report(ctx: &EvalContext, results: &UnitResults) -> Result<EvalRep
          wrong). A \
          wrong loop is marked **at a disputed reference** when one of its two scans, placed at \
          its reference pose, has less than half of its points (within 10 m) within 0.1 m of the \
-         referenced scans more than 30 scans away (`LoopCheck::reference_disputed`): there the \
+         referenced scans more than 30 scans away, or when a consecutive relation of the corrected \
+         log within three referenced scans of either scan is refuted by its two scans (its \
+         reference lays less than half of the second scan on the first, and aligning them from \
+         it reaches a relation that does, more than 0.3 m or 3° away: \
+         `reference_refuted_near`) (`LoopCheck::reference_disputed`): there the \
          corrected log disagrees with itself, and the association error says nothing about the \
          loop. The count stays in the wrong column. fr-clinic has no corrected log in the data set; it is in the \
          second table.\n",
