@@ -149,7 +149,7 @@ impl LoopCheck {
 
     /// Whether the reference itself is in doubt at this loop closure: one of its two scans,
     /// placed at its reference pose, has less than half of its points (within
-    /// [`SUPPORT_RANGE_M`]) within [`SUPPORT_TOLERANCE_M`] of the points of the referenced
+    /// [`super::SUPPORT_RANGE_M`]) within [`super::SUPPORT_TOLERANCE_M`] of the points of the referenced
     /// scans more than [`DISPUTE_GAP`] scans away, placed at theirs ([`reference_support`]).
     /// A corrected log can be wrong at single scans; an association error measured against
     /// such a reference says nothing about the loop closure. Reported beside the wrong
@@ -187,8 +187,8 @@ pub fn wrong_at_disputed_reference(
 /// [`reference_support`] checks it against: 30, a few metres of travel in the logs we read.
 pub const DISPUTE_GAP: usize = 30;
 
-/// The share of scan `i`'s points (within [`SUPPORT_RANGE_M`]), placed at `pose`, within
-/// [`SUPPORT_TOLERANCE_M`] of the points of every referenced scan more than [`DISPUTE_GAP`]
+/// The share of scan `i`'s points (within [`super::SUPPORT_RANGE_M`]), placed at `pose`, within
+/// [`super::SUPPORT_TOLERANCE_M`] of the points of every referenced scan more than [`DISPUTE_GAP`]
 /// scans from `i`, placed at its reference pose; `None` without points.
 /// See [`reference_refuted_near`] for the other ground of a dispute.
 pub fn reference_support(
