@@ -1,31 +1,5 @@
-//! **Scan-refined relations**: a reference relation between two scans, refined by aligning the
-//! two scans themselves, and kept only where that alignment is unique and well constrained.
-//!
-//! A corrected log is itself the output of a mapping run, so its relations carry its own local
-//! errors, and an estimate scored against them is charged those too. Aligned from the
-//! reference relation, the two scans of a consecutive pair move on average by about 3 cm on
-//! the corrected Intel log (`cargo xtask eval slam` reports this per log as the reference's
-//! own disagreement with the scans). Kümmerle et al. (2009) built the benchmark's relations
-//! from scan alignments that a person checked; here the check is automatic:
-//!
-//! 1. **alignment**: point-to-line ICP (Chen & Medioni 1992, in 2-D) of scan `j` onto scan
-//!    `i`, started at the reference relation; correspondence gates narrowing from 0.3 to 0.08
-//!    m, Cauchy weights; line normals from the neighbours of each point of scan `i`;
-//! 2. **unique**: restarts from the reference moved by ±5 cm and ±1° reach the same relation
-//!    (within 5 mm and 0.1°);
-//! 3. **constrained**: the matched line normals span the plane (the smaller eigenvalue of
-//!    their scatter is at least 0.05 of the total) — in a corridor one direction stays free;
-//! 4. **supported**: at the refined relation at least half of scan `j`'s points (within
-//!    [`super::SUPPORT_RANGE_M`]) lie within [`super::SUPPORT_TOLERANCE_M`] of a point of
-//!    scan `i`, as in
-//!    [`super::scan_supported`];
-//! 5. **near the reference**: the refinement moves the reference by at most 0.2 m and 3°;
-//!    farther, the reference or the alignment is wrong, and the check cannot tell which.
-//!
-//! The alignment is not raypath-slam's matcher (no grid, no map, no odometry), and the checks
-//! look at the reference and the two scans only, never at an estimate. Refined relations still
-//! favour every method that aligns scans — as the benchmark's own relations do — so they are
-//! reported beside the derived relations, never instead of them.
+//! Scan-refined relations: reference relations refined by aligning their own two scans,
+//! kept where that alignment is unique and well constrained ([`refine_relations`]).
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use nalgebra::{Matrix2, Matrix3, Point2, Vector2, Vector3};
@@ -33,24 +7,26 @@ use raypath_geometry::{Pose2, Scan2};
 
 use super::{near_points, reference_pair};
 
-/// Settings of [`refine_relations`]; the defaults are ours (module docs).
+/// Settings of [`refine_relations`]; the defaults are ours (its docs give them in words).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RefineConfig {
-    /// Correspondence gates of the successive ICP stages, metres, narrowing.
+    /// Correspondence gates of the successive ICP stages, metres, narrowing. Default 0.3,
+    /// 0.15, 0.08.
     pub gates_m: Vec<f64>,
-    /// Iterations per stage at most.
+    /// Iterations per stage at most. Default 20.
     pub iterations: usize,
-    /// Scale of the Cauchy weights on point-to-line residuals, metres.
+    /// Scale of the Cauchy weights on point-to-line residuals, metres. Default 0.02.
     pub kernel_m: f64,
     /// Offsets of the restarts from the reference: ± this translation (m) and angle (rad).
+    /// Default 0.05 m, 1°.
     pub restart_offset: (f64, f64),
-    /// Restarts agree when within this translation (m) and angle (rad).
+    /// Restarts agree when within this translation (m) and angle (rad). Default 5 mm, 0.1°.
     pub agreement: (f64, f64),
-    /// Smallest share of the matched normals' scatter in its weaker direction.
+    /// Smallest share of the matched normals' scatter in its weaker direction. Default 0.05.
     pub min_constraint: f64,
-    /// Largest correction of the reference: translation (m) and angle (rad).
+    /// Largest correction of the reference: translation (m) and angle (rad). Default 0.2 m, 3°.
     pub max_correction: (f64, f64),
-    /// Neighbours of a point within this radius fit its line, metres.
+    /// Neighbours of a point within this radius fit its line, metres. Default 0.3.
     pub normal_radius_m: f64,
 }
 
@@ -133,7 +109,34 @@ pub struct Refined {
 }
 
 /// Refines the reference relations `pairs` of `scans` (reference poses `reference[k]` of scan
-/// `k`) by aligning the scans (module docs); an error only for invalid settings.
+/// `k`) by aligning their two scans; an error only for invalid settings.
+///
+/// A corrected log is itself the output of a mapping run, so its relations carry its own local
+/// errors, and an estimate scored against them is charged those too. Aligned from the
+/// reference relation, the two scans of a consecutive pair of the corrected benchmark logs
+/// move by centimetres (`cargo xtask eval slam` reports how far per log: the reference's own
+/// disagreement with its scans). Kümmerle et al. (2009) built the benchmark's relations
+/// from scan alignments that a person checked; here the check is automatic:
+///
+/// 1. **alignment**: point-to-line ICP (Chen & Medioni 1992, in 2-D) of scan `j` onto scan
+///    `i`, started at the reference relation; correspondence gates narrowing from 0.3 to 0.08
+///    m, Cauchy weights; line normals from the neighbours of each point of scan `i`;
+/// 2. **unique**: restarts from the reference moved by ±5 cm and ±1° reach the same relation
+///    (within 5 mm and 0.1°);
+/// 3. **constrained**: the matched line normals span the plane (the smaller eigenvalue of
+///    their scatter is at least 0.05 of the total) — in a corridor one direction stays free;
+/// 4. **supported**: at the refined relation at least half of scan `j`'s points (within
+///    [`super::SUPPORT_RANGE_M`]) lie within [`super::SUPPORT_TOLERANCE_M`] of a point of
+///    scan `i`, as in [`super::scan_supported`];
+/// 5. **near the reference**: the refinement moves the reference by at most 0.2 m and 3°;
+///    farther, the reference or the alignment is wrong, and the check cannot tell which.
+///
+/// The alignment is not raypath-slam's matcher (no grid, no map, no odometry), and the checks
+/// look at the reference and the two scans only, never at an estimate. Refined relations still
+/// favour every method that aligns scans — as the benchmark's own relations do — so they are
+/// reported beside the derived relations, never instead of them.
+///
+/// The settings and their defaults (ours) are in [`RefineConfig`].
 pub fn refine_relations(
     scans: &[&Scan2],
     reference: &[Option<Pose2>],
@@ -192,8 +195,8 @@ impl Refusal {
     }
 }
 
-/// Aligns `scan_j` onto `scan_i` from `initial` (`i_from_j`) and applies the checks of the
-/// module docs: the refined `i_from_j`, or why not.
+/// Aligns `scan_j` onto `scan_i` from `initial` (`i_from_j`) and applies the checks of
+/// [`refine_relations`]: the refined `i_from_j`, or why not.
 pub fn refine(
     scan_i: &Scan2,
     scan_j: &Scan2,
