@@ -107,8 +107,8 @@ pub struct LoopSearchConfig {
     /// over the window's headings at least [`Self::ambiguity_min_angle_rad`] away from the
     /// match, finds a pose reaching this share of its score (`None`: no test). Default 0.9
     /// (ours): on the raw Intel log it refuses the loop closure that was 8.9° off the corrected
-    /// log while both submaps agreed with it (24 of 977 matches refused, the relation errors
-    /// unchanged); 0.8 refuses 2.5× as many without removing another wrong one.
+    /// log while both submaps agreed with it, leaving the relation errors as they were; 0.8
+    /// refuses far more matches without removing another wrong one.
     pub ambiguity_ratio: Option<f64>,
     /// See [`Self::ambiguity_ratio`], radians. Default 3° (the wrong-loop threshold of
     /// `docs/results/slam.md`).
@@ -118,10 +118,9 @@ pub struct LoopSearchConfig {
     /// [`Self::ambiguity_ratio`] of its score, metres (`None`: no test). Default 0.3 m (ours,
     /// the wrong-loop threshold of `docs/results/slam.md`): on the raw MIT CSAIL log it refuses
     /// the one loop closure that was placed 0.32 m along a corridor from the corrected log's
-    /// pose while the scans supported both (0.90 and 0.92 of their points). It also refuses
-    /// right matches: with both tests 106 of 988 matches are refused on Intel (24 of 977 with
-    /// the rotation test alone), 66 of 259 on MIT CSAIL (4 of 257), 6 of 271 on fr079 (4 of
-    /// 272); the accepted loop closures go from 913 to 865, 235 to 190 and 267 to 264.
+    /// pose while the scans supported both. It also refuses right matches, most in the
+    /// corridors of MIT CSAIL (fewer loop closures accepted; `docs/results/slam.md` has the
+    /// counts); the relation errors stay as they were.
     pub ambiguity_min_shift_m: Option<f64>,
 }
 
