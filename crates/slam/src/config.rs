@@ -120,7 +120,7 @@ pub struct LoopSearchConfig {
     /// the one loop closure that was placed 0.32 m along a corridor from the corrected log's
     /// pose while the scans supported both. It also refuses right matches, most in the
     /// corridors of MIT CSAIL (fewer loop closures accepted; `docs/results/slam.md` has the
-    /// counts); the relation errors stay as they were.
+    /// counts); the consecutive relation errors stay as they were.
     pub ambiguity_min_shift_m: Option<f64>,
 }
 
