@@ -23,24 +23,25 @@ fn rect(lo: [f64; 2], hi: [f64; 2]) -> Vec<Wall> {
     (0..4).map(|k| (c[k], c[(k + 1) % 4])).collect()
 }
 
-/// A 360-beam scan of `walls` from `pose` (9 m maximum range).
+/// A 360-beam scan of `walls` from `pose` (9 m maximum range), cast by the simulator.
 fn scan_at(walls: &[Wall], pose: Pose2) -> Scan2 {
+    use nalgebra::Point2;
+    use raypath_sim::scene2::{SceneBuilder2, Surface};
+    let mut builder = SceneBuilder2::new();
+    let wall = builder.add_surface(Surface {
+        label: 1,
+        reflectivity: 0.5,
+    });
+    for (a, b) in walls {
+        builder.add_segment(Point2::new(a[0], a[1]), Point2::new(b[0], b[1]), wall);
+    }
+    let scene = builder.build().unwrap();
     let n = 360;
+    let origin = Point2::new(pose.x(), pose.y());
     let ranges = (0..n)
         .map(|k| {
             let a = pose.theta() + k as f64 * TAU / n as f64;
-            let d = [a.cos(), a.sin()];
-            walls
-                .iter()
-                .filter_map(|(p, q)| {
-                    let e = [q[0] - p[0], q[1] - p[1]];
-                    let den = d[0] * e[1] - d[1] * e[0];
-                    let w = [p[0] - pose.x(), p[1] - pose.y()];
-                    let t = (w[0] * e[1] - w[1] * e[0]) / den;
-                    let s = (w[0] * d[1] - w[1] * d[0]) / den;
-                    (den.abs() > 1e-12 && t > 0.0 && (0.0..=1.0).contains(&s)).then_some(t)
-                })
-                .fold(9.0, f64::min)
+            scene.cast_angle(&origin, a, 9.0).map_or(9.0, |h| h.range_m)
         })
         .collect();
     Scan2 {
