@@ -190,8 +190,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 &consecutive_relations(&referenced),
                 &RefineConfig::default(),
             )?;
-            let moved = refined.corrections_m.iter().sum::<f64>()
-                / refined.corrections_m.len().max(1) as f64;
+            let (moved, _) = refined.correction_m();
             println!(
                 "scan-refined: {:?} in {:.1} s; kept {}, reference moved {moved:.4} m on average, dropped {:?}",
                 explicit_relation_errors(&out.world_from_sensor, &refined.relations),

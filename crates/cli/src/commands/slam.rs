@@ -314,8 +314,7 @@ fn evaluate(
         &RefineConfig::default(),
     )
     .map_err(Failure::internal)?;
-    let moved =
-        refined.corrections_m.iter().sum::<f64>() / refined.corrections_m.len().max(1) as f64;
+    let (moved, _) = refined.correction_m();
     let disputed = raypath_slam::benchmark::wrong_at_disputed_reference(&checks, &scans, &truth);
     Ok(json!({
         "paired_scans": paired,

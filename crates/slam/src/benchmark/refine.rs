@@ -108,6 +108,21 @@ pub struct Refined {
     pub dropped: Dropped,
 }
 
+impl Refined {
+    /// Mean and standard deviation of [`Self::corrections_m`], metres (zeros when none was
+    /// kept): how far the reference sits from its scans.
+    pub fn correction_m(&self) -> (f64, f64) {
+        let c = &self.corrections_m;
+        if c.is_empty() {
+            return (0.0, 0.0);
+        }
+        let n = c.len() as f64;
+        let mean = c.iter().sum::<f64>() / n;
+        let var = c.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
+        (mean, var.sqrt())
+    }
+}
+
 /// Refines the reference relations `pairs` of `scans` (reference poses `reference[k]` of scan
 /// `k`) by aligning their two scans; an error only for invalid settings.
 ///
@@ -145,20 +160,19 @@ pub fn refine_relations(
 ) -> crate::Result<Refined> {
     use rayon::prelude::*;
     config.validate()?;
-    let results: Vec<Result<Pose2, Refusal>> = pairs
+    let results: Vec<Result<(Pose2, f64), Refusal>> = pairs
         .par_iter()
         .map(|&pair| {
             let (si, sj, i_from_j) =
                 reference_pair(scans, reference, pair).ok_or(Refusal::Unaligned)?;
-            refine(si, sj, i_from_j, config)
+            let refined = refine(si, sj, i_from_j, config)?;
+            Ok((refined, (i_from_j.inverse() * refined).translation().norm()))
         })
         .collect();
     let mut out = Refined::default();
     for (&(i, j), result) in pairs.iter().zip(results) {
         match result {
-            Ok(pose) => {
-                let initial = reference[i].zip(reference[j]).map(|(a, b)| a.inverse() * b);
-                let moved = initial.map_or(0.0, |x| (x.inverse() * pose).translation().norm());
+            Ok((pose, moved)) => {
                 out.corrections_m.push(moved);
                 out.relations.push((i, j, pose));
             }

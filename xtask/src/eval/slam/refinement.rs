@@ -20,18 +20,10 @@ use crate::table::{Table, fmt_num};
 /// refinement measures on the real logs.
 const CHECK_NOISE: (f64, f64) = (0.02, 0.3);
 
-/// Mean and standard deviation.
-fn mean_std(values: &[f64]) -> (f64, f64) {
-    let n = values.len().max(1) as f64;
-    let mean = values.iter().sum::<f64>() / n;
-    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
-    (mean, var.sqrt())
-}
-
 /// The refinement of a log's consecutive relations: kept, dropped by reason, and how far the
 /// kept ones moved their reference.
 pub(super) fn of_reference(log: &str, rel: &Relations) -> Value {
-    let (moved, moved_std) = mean_std(&rel.refined.corrections_m);
+    let (moved, moved_std) = rel.refined.correction_m();
     json!({
         "log": log, "consecutive": rel.consecutive.len(),
         "kept": rel.refined.relations.len(), "dropped": rel.refined.dropped,

@@ -136,6 +136,9 @@ fn relations_are_refined_or_counted() {
     assert_eq!((i, j), (0, 1));
     assert!(off_by(poses[0].inverse() * poses[1], rel).0 < 1e-3);
     assert!((out.corrections_m[0] - 0.02).abs() < 2e-3);
+    let (mean, std) = out.correction_m();
+    assert!(mean == out.corrections_m[0] && std == 0.0);
+    assert_eq!(Refined::default().correction_m(), (0.0, 0.0));
 }
 
 /// With range noise (σ 1 cm, seeded), a reference off by 3 cm and 0.5° lands within a few
