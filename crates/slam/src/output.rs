@@ -14,7 +14,9 @@ use crate::submap::Submap;
 /// One processed scan.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ScanPose {
-    /// Time of the scan, seconds.
+    /// Time of the scan, seconds: the sensor's time stamp when the scan came through
+    /// [`crate::Slam::process`] (the CARMEN ipc time stamp, a bag's header stamp; see
+    /// [`PlanarFrame::sensor_stamp_secs`]).
     pub stamp_secs: f64,
     /// The front-end's pose of the scan in its local (never corrected) frame.
     pub local: Pose2,
@@ -68,7 +70,9 @@ pub struct SlamOutput {
 }
 
 impl SlamOutput {
-    /// The trajectory as TUM lines (`t x y z qx qy qz qw`, z = 0, a yaw quaternion).
+    /// The trajectory as TUM lines (`t x y z qx qy qz qw`, z = 0, a yaw quaternion), each
+    /// pose at its scan's own time stamp ([`ScanPose::stamp_secs`]: the sensor's time), so
+    /// `evo` and the SLAM benchmark's relation files join on it.
     pub fn tum(&self) -> String {
         raypath_reflectivity::export::tum_lines(
             self.scans

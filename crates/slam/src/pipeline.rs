@@ -98,14 +98,16 @@ impl Slam {
     }
 
     /// Processes one frame: its scan, and its logged `world_from_laser` as odometry when
-    /// [`SlamConfig::use_odometry`] is set.
+    /// [`SlamConfig::use_odometry`] is set. The scan is stamped with the sensor's time
+    /// ([`PlanarFrame::sensor_stamp_secs`]: the CARMEN ipc time stamp, a bag's header stamp),
+    /// so the trajectory joins with relation files and other tools by time.
     pub fn process(&mut self, frame: &PlanarFrame) -> Result<()> {
         let odometry = self
             .config
             .use_odometry
             .then_some(frame.world_from_laser)
             .filter(Pose2::is_finite);
-        self.process_scan(frame.stamp_secs, &frame.scan, odometry)
+        self.process_scan(frame.sensor_stamp_secs(), &frame.scan, odometry)
     }
 
     /// Processes one scan taken at `stamp_secs` with the odometry pose `odometry`

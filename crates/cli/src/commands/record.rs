@@ -183,7 +183,7 @@ impl Recording {
             let robot_from_laser = frame.robot_from_laser();
             let world_from_robot = *pose * robot_from_laser.inverse();
             self.planar_scan(
-                frame.stamp_secs,
+                frame.sensor_stamp_secs(),
                 &world_from_robot,
                 &robot_from_laser,
                 &frame.scan,

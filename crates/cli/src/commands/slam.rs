@@ -11,7 +11,9 @@
 //! ```
 //!
 //! Writes into `DIR`: `trajectory.txt` (TUM `t x y z qx qy qz qw`, the laser pose of every
-//! scan in the optimised map frame, which starts at the first scan), `corrected.log` (the
+//! scan in the optimised map frame, which starts at the first scan, at the scan's own sensor
+//! time stamp: the CARMEN ipc time stamp — the one the SLAM benchmark's relation files use —
+//! or a bag message's header stamp, so `evo` and relation files join on it), `corrected.log` (the
 //! scans as a CARMEN corrected log with the optimised poses), the map rebuilt from the
 //! optimised poses with the sensor model `--model` (`map.pgm` + `map.yaml`, `map.png`,
 //! `map.rpmap`: as `raypath map` writes them) and `loop_closures.csv` (one accepted loop

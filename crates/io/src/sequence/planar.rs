@@ -81,6 +81,17 @@ pub struct PlanarFrame {
 }
 
 impl PlanarFrame {
+    /// The time the sensor took the scan, seconds: the one benchmark tools and `evo` join
+    /// trajectories on. The CARMEN ipc time stamp where the source has one (set by the laser
+    /// driver when it sent the scan; the SLAM benchmark's relation files name scans by it),
+    /// else [`Self::stamp_secs`] (a bag's header stamp). The CARMEN logger time in
+    /// [`Self::stamp_secs`] is when the logger received the message, counted from its start.
+    pub fn sensor_stamp_secs(&self) -> f64 {
+        self.ipc_stamp_secs
+            .filter(|t| t.is_finite())
+            .unwrap_or(self.stamp_secs)
+    }
+
     /// The laser's mounting `robot_from_laser`.
     pub fn robot_from_laser(&self) -> Pose2 {
         self.world_from_robot.inverse() * self.world_from_laser
