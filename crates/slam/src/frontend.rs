@@ -31,6 +31,8 @@ pub(crate) struct FrontEnd {
     rotation_window_rad: f64,
     rotation_step_rad: f64,
     rotation_min_gain: f64,
+    rotation_window_growth: f64,
+    max_speed_mps: f64,
 }
 
 impl FrontEnd {
@@ -48,6 +50,8 @@ impl FrontEnd {
             rotation_window_rad: config.submaps.rotation_window_rad,
             rotation_step_rad: config.submaps.rotation_step_rad,
             rotation_min_gain: config.submaps.rotation_min_gain,
+            rotation_window_growth: config.submaps.rotation_window_growth,
+            max_speed_mps: config.submaps.max_speed_mps,
         }
     }
 
@@ -57,8 +61,14 @@ impl FrontEnd {
     }
 
     /// Matches a scan: `odometry` is the logged `world_from_sensor` of the odometry (or `None`
-    /// to predict no motion). Returns the local pose and the matcher's covariance.
-    pub fn track(&mut self, points: &ScanPoints, odometry: Option<Pose2>) -> (Pose2, Matrix3<f64>) {
+    /// to predict no motion), `dt_secs` the time since the last scan (0 when unknown). Returns
+    /// the local pose and the matcher's covariance.
+    pub fn track(
+        &mut self,
+        points: &ScanPoints,
+        odometry: Option<Pose2>,
+        dt_secs: f64,
+    ) -> (Pose2, Matrix3<f64>) {
         let delta = match (self.last_odometry, odometry) {
             (Some(a), Some(b)) => a.inverse() * b,
             _ => Pose2::identity(),
@@ -72,12 +82,14 @@ impl FrontEnd {
                 let submap_from_local = submap.local_from_submap.inverse();
                 let mut initial = submap_from_local * guess;
                 if self.rotation_window_rad > 0.0 {
+                    let window = self.rotation_window_rad
+                        + self.rotation_window_growth * delta.theta().abs();
                     let search = |start: Pose2| {
                         rotation_search(
                             submap.map.levels(),
                             points,
                             start,
-                            self.rotation_window_rad,
+                            window,
                             self.rotation_step_rad,
                             self.rotation_min_gain,
                         )
@@ -85,12 +97,16 @@ impl FrontEnd {
                     let (from_odometry, score) = search(initial);
                     initial = from_odometry;
                     // A glitch in the odometry (a jump in the log, wheel slip) moves the guess
-                    // out of every basin: when the increment turns beyond the search window
-                    // or moves more than two coarsest cells, the pose of the last scan (no
-                    // motion) is a second candidate, taken when it scores clearly better.
+                    // out of every basin: when the increment turns beyond the search window,
+                    // or moves more than two coarsest cells faster than the robot can drive,
+                    // the pose of the last scan (no motion) is a second candidate, taken when
+                    // it scores clearly better.
                     let coarsest = submap.map.levels().last().map_or(0.0, |l| l.resolution_m());
-                    if delta.theta().abs() > self.rotation_window_rad
-                        || delta.translation().norm() > 2.0 * coarsest
+                    let step = delta.translation().norm();
+                    if delta.theta().abs() > window
+                        || (dt_secs > 0.0
+                            && step > 2.0 * coarsest
+                            && step > self.max_speed_mps * dt_secs)
                     {
                         let (standing, standing_score) = search(submap_from_local * self.local);
                         if standing_score > score + self.rotation_min_gain {

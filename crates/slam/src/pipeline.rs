@@ -127,7 +127,11 @@ impl Slam {
         let t0 = Instant::now();
         self.points
             .fill_from_scan(scan, &self.config.filter, self.correction.as_ref());
-        let (local, _) = self.frontend.track(&self.points, odometry);
+        let dt_secs = self
+            .scans
+            .last()
+            .map_or(0.0, |last| (stamp_secs - last.stamp_secs).max(0.0));
+        let (local, _) = self.frontend.track(&self.points, odometry, dt_secs);
         let node = if self.frontend.wants_node(&self.config) {
             Some(self.add_node(stamp_secs, local)?)
         } else {
