@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::correlative::CorrelativeConfig;
 use crate::error::{Result, SlamError, require_positive};
+use crate::global_search::GlobalSearchConfig;
 use crate::graph::SolverConfig;
 
 /// How scans become nodes and nodes fill submaps (the front-end).
@@ -139,6 +140,13 @@ pub struct LoopSearchConfig {
     /// corridors of MIT CSAIL (fewer loop closures accepted; `docs/results/slam.md` has the
     /// counts); the consecutive relation errors stay as they were.
     pub ambiguity_min_shift_m: Option<f64>,
+    /// The global search: a wide window once the path since the last loop closure is long
+    /// (see [`crate::global_search`]; `None`: off). Default `None` (off, ours): on the raw
+    /// `ual` log it finds the loop's end 22 m and 11° from its start (score 0.58), but the
+    /// robust pose graph rejects that one constraint at the end, so the map stays as it was;
+    /// on `fr-clinic` it matches nothing (scores below the minimum) and adds about a minute.
+    /// Turn it on with `Some(GlobalSearchConfig::default())`.
+    pub global: Option<GlobalSearchConfig>,
 }
 
 impl Default for LoopSearchConfig {
@@ -161,6 +169,7 @@ impl Default for LoopSearchConfig {
             ambiguity_ratio: Some(0.9),
             ambiguity_min_angle_rad: 3f64.to_radians(),
             ambiguity_min_shift_m: Some(0.3),
+            global: None,
         }
     }
 }
@@ -333,6 +342,9 @@ impl LoopSearchConfig {
                     self.ambiguity_min_angle_rad
                 ),
             });
+        }
+        if let Some(global) = &self.global {
+            global.validate()?;
         }
         if !(self.radius_growth >= 0.0 && self.radius_growth.is_finite()) {
             return Err(SlamError::InvalidParameter {

@@ -127,6 +127,7 @@ mod config;
 pub mod correlative;
 mod error;
 mod frontend;
+pub mod global_search;
 pub mod graph;
 mod loops;
 mod output;
@@ -135,6 +136,7 @@ mod submap;
 
 pub use config::{LoopSearchConfig, Sigmas, SlamConfig, SubmapConfig};
 pub use error::{Result, SlamError};
+pub use global_search::GlobalSearchConfig;
 pub use loops::{LoopClosure, LoopSource, LoopStats};
 pub use output::{ScanPose, SlamOutput, SlamStats};
 pub use pipeline::Slam;

@@ -27,6 +27,7 @@ use raypath_reflectivity::{MatcherConfig, ScanPoints, match_levels};
 use crate::config::LoopSearchConfig;
 use crate::correlative::{SearchWindow, match_scan};
 use crate::error::Result;
+use crate::global_search::GlobalSearchConfig;
 use crate::submap::Submap;
 
 /// Where a loop candidate came from.
@@ -37,6 +38,8 @@ pub enum LoopSource {
     Nearby,
     /// Place recognition (planar polar context).
     PlaceRecognition,
+    /// The global search's wide window ([`crate::global_search`]).
+    Global,
 }
 
 /// An accepted loop constraint: node `node` seen in submap `submap` at `submap_from_sensor`.
@@ -80,6 +83,8 @@ pub struct LoopStats {
     pub refinement_rejected: usize,
     /// Matches refused as ambiguous in rotation.
     pub ambiguous_rejected: usize,
+    /// Node–submap pairs searched by the global search (also counted in `candidates`).
+    pub global_candidates: usize,
 }
 
 /// The loop closer's state: polar-context descriptions of the nodes.
@@ -139,45 +144,110 @@ impl LoopCloser {
         };
         let candidates =
             self.candidates(node, world_from_node, nodes, node_submap, submaps, travel_m);
-        if candidates.is_empty() {
+        let global = self.config.global.filter(|g| g.due(node, travel_m));
+        if candidates.is_empty() && global.is_none() {
             return Vec::new();
         }
         thin(points.points(), self.config.thinning_m, &mut self.thinned);
-        let mut out = Vec::new();
-        for c in candidates {
-            self.stats.candidates += 1;
-            if c.source == LoopSource::PlaceRecognition {
-                self.stats.place_recognition_candidates += 1;
-            }
-            let Some(submap) = submaps.get(c.submap) else {
-                continue;
-            };
-            let Some(m) = match_scan(
-                submap.precomputed(),
-                &self.thinned,
-                c.initial,
-                &c.window,
-                &self.config.correlative,
-            ) else {
-                continue;
-            };
-            self.stats.matched += 1;
-            if self.rotation_ambiguous(submap, &c, &m) || self.translation_ambiguous(submap, &m) {
-                self.stats.ambiguous_rejected += 1;
-                continue;
-            }
-            let (refined, _) =
-                match_levels(submap.levels(), matcher, points, m.submap_from_sensor, None);
-            let jump = (m.submap_from_sensor.inverse() * refined)
-                .translation()
-                .norm();
-            if !refined.is_finite() || jump > self.config.max_refinement_m {
-                self.stats.refinement_rejected += 1;
-                continue;
-            }
-            out.push((c.submap, refined, m.score, c.source));
+        let mut out: Vec<_> = candidates
+            .into_iter()
+            .filter_map(|c| self.verify(&c, points, submaps, matcher))
+            .collect();
+        if let Some(global) = global.filter(|_| out.is_empty()) {
+            let wide =
+                self.global_candidates(&global, node, world_from_node, nodes, submaps, travel_m);
+            self.stats.global_candidates += wide.len();
+            out.extend(
+                wide.iter()
+                    .filter_map(|c| self.verify(c, points, submaps, matcher)),
+            );
         }
         out
+    }
+
+    /// Branch and bound over the candidate's window, the ambiguity tests and the Gauss–Newton
+    /// refinement: the loop constraint `(submap, submap_from_sensor, score, source)` or `None`.
+    fn verify(
+        &mut self,
+        c: &Candidate,
+        points: &ScanPoints,
+        submaps: &[Submap],
+        matcher: &MatcherConfig,
+    ) -> Option<(usize, Pose2, f64, LoopSource)> {
+        self.stats.candidates += 1;
+        if c.source == LoopSource::PlaceRecognition {
+            self.stats.place_recognition_candidates += 1;
+        }
+        let submap = submaps.get(c.submap)?;
+        let m = match_scan(
+            submap.precomputed(),
+            &self.thinned,
+            c.initial,
+            &c.window,
+            &self.config.correlative,
+        )?;
+        self.stats.matched += 1;
+        if self.rotation_ambiguous(submap, c, &m) || self.translation_ambiguous(submap, &m) {
+            self.stats.ambiguous_rejected += 1;
+            return None;
+        }
+        let (refined, _) =
+            match_levels(submap.levels(), matcher, points, m.submap_from_sensor, None);
+        let jump = (m.submap_from_sensor.inverse() * refined)
+            .translation()
+            .norm();
+        if !refined.is_finite() || jump > self.config.max_refinement_m {
+            self.stats.refinement_rejected += 1;
+            return None;
+        }
+        Some((c.submap, refined, m.score, c.source))
+    }
+
+    /// The global search's candidates ([`crate::global_search`]): the nearest finished
+    /// submaps within the wide window's reach of the node's estimate, each with that window.
+    fn global_candidates(
+        &self,
+        global: &GlobalSearchConfig,
+        node: usize,
+        world_from_node: Pose2,
+        nodes: &[Pose2],
+        submaps: &[Submap],
+        travel_m: f64,
+    ) -> Vec<Candidate> {
+        let window = SearchWindow {
+            linear_m: global.linear_window_m(travel_m),
+            angular_rad: self.config.angular_window_rad,
+        };
+        let reach = self.config.search_radius_m + window.linear_m;
+        let mut out: Vec<(f64, Candidate)> = submaps
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| {
+                s.nodes()
+                    .last()
+                    .is_some_and(|&last| last + self.config.min_node_gap <= node)
+            })
+            .filter_map(|(k, s)| {
+                let world_from_submap = *nodes.get(s.anchor())?;
+                let centre =
+                    world_from_submap * nalgebra::Point2::new(s.centre()[0], s.centre()[1]);
+                let d = (centre.coords - world_from_node.translation()).norm();
+                (d <= reach).then_some((
+                    d,
+                    Candidate {
+                        submap: k,
+                        initial: world_from_submap.inverse() * world_from_node,
+                        window,
+                        source: LoopSource::Global,
+                    },
+                ))
+            })
+            .collect();
+        out.sort_by(|a, b| a.0.total_cmp(&b.0));
+        out.into_iter()
+            .take(global.max_candidates)
+            .map(|(_, c)| c)
+            .collect()
     }
 
     /// Whether a pose at least `ambiguity_min_angle_rad` away in rotation scores nearly as
@@ -481,6 +551,82 @@ mod tests {
             ([1.0, 1.0], [1.0, 0.5]),
         ]);
         assert_eq!(ambiguous(&room), (false, false));
+    }
+
+    /// A 6 m × 4 m room with a pillar off the centre.
+    fn room_with_pillar() -> Vec<([f64; 2], [f64; 2])> {
+        vec![
+            ([-3.0, -2.0], [3.0, -2.0]),
+            ([3.0, -2.0], [3.0, 2.0]),
+            ([3.0, 2.0], [-3.0, 2.0]),
+            ([-3.0, 2.0], [-3.0, -2.0]),
+            ([1.0, 0.5], [1.6, 0.5]),
+            ([1.6, 0.5], [1.6, 1.0]),
+            ([1.6, 1.0], [1.0, 1.0]),
+            ([1.0, 1.0], [1.0, 0.5]),
+        ]
+    }
+
+    /// Searches the room's submap (anchor node 0 at the origin, finished long ago) for node
+    /// 200, whose estimate is `estimate`, after `travel_m` without a loop closure; the scan is
+    /// `walls` seen from the origin.
+    fn search_room(
+        config: LoopSearchConfig,
+        walls: &[([f64; 2], [f64; 2])],
+        estimate: Pose2,
+        travel_m: f64,
+    ) -> Vec<(usize, Pose2, f64, LoopSource)> {
+        let (mut submap, _) = room_submap(&room_with_pillar());
+        submap.set_nodes_for_test(vec![0, 1]);
+        let (_, raw) = room_submap(walls);
+        let mut points = ScanPoints::new();
+        for p in &raw {
+            points.push(*p, f64::NAN);
+        }
+        let node = 210;
+        let mut nodes = vec![Pose2::identity(); node + 1];
+        nodes[node] = estimate;
+        let mut closer = LoopCloser::new(config, 30.0).unwrap();
+        closer.search(
+            node,
+            &points,
+            &nodes,
+            &[Some(0), Some(0)],
+            &[submap],
+            &MatcherConfig::default(),
+            travel_m,
+        )
+    }
+
+    #[test]
+    fn the_global_search_closes_a_loop_beyond_the_local_window_and_no_wrong_one() {
+        let config = LoopSearchConfig {
+            place_recognition: false,
+            global: Some(GlobalSearchConfig::default()),
+            ..LoopSearchConfig::default()
+        };
+        // The node sees the room from its origin, but its estimate drifted 8 m and 6°: beyond
+        // the local window (5 m at most), within the global one (0.06 × 200 m = 12 m).
+        let estimate = Pose2::new(6.0, -5.3, 0.1);
+        let local_only = LoopSearchConfig {
+            global: None,
+            ..config
+        };
+        assert!(search_room(local_only, &room_with_pillar(), estimate, 200.0).is_empty());
+        let found = search_room(config, &room_with_pillar(), estimate, 200.0);
+        assert_eq!(found.len(), 1, "{found:?}");
+        let (submap, pose, score, source) = found[0];
+        assert_eq!((submap, source), (0, LoopSource::Global));
+        assert!(score >= config.correlative.min_score);
+        assert!(
+            pose.translation().norm() < 0.05 && pose.theta().abs() < 0.01,
+            "{pose:?}"
+        );
+        // Too little path since the last loop: no global search.
+        assert!(search_room(config, &room_with_pillar(), estimate, 20.0).is_empty());
+        // Another place (a featureless corridor) is not matched into the room.
+        let corridor = [([-8.0, -1.0], [8.0, -1.0]), ([-8.0, 1.0], [8.0, 1.0])];
+        assert!(search_room(config, &corridor, estimate, 200.0).is_empty());
     }
 
     #[test]

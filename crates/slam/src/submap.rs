@@ -91,6 +91,12 @@ impl Submap {
         &self.nodes
     }
 
+    /// Replaces the node list (tests of the loop search).
+    #[cfg(test)]
+    pub(crate) fn set_nodes_for_test(&mut self, nodes: Vec<usize>) {
+        self.nodes = nodes;
+    }
+
     /// The centre of the observed box in the submap frame, metres.
     pub fn centre(&self) -> [f64; 2] {
         self.centre
