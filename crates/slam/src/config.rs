@@ -3,9 +3,11 @@
 use raypath_reflectivity::{MapConfig, MatcherConfig, PointFilter};
 use serde::{Deserialize, Serialize};
 
+use crate::consistency::ConsistencyConfig;
 use crate::correlative::CorrelativeConfig;
 use crate::error::{Result, SlamError, require_positive};
 use crate::graph::SolverConfig;
+use crate::guard::TrackingGuardConfig;
 
 /// How scans become nodes and nodes fill submaps (the front-end).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -189,6 +191,13 @@ pub struct SlamConfig {
     /// loop closures that the corrected log's own map refutes end well below it, right ones
     /// almost never (the wrong-loop counts are in `docs/results/slam.md`).
     pub reject_weight: f64,
+    /// The front-end's guards against odometry outliers and failed matches
+    /// ([`crate::guard`]).
+    pub tracking: TrackingGuardConfig,
+    /// The consistency test every loop candidate passes before it enters the pose graph
+    /// ([`crate::consistency`]); `None`: every verified match enters (the robust back-end alone
+    /// judges it). Default on.
+    pub consistency: Option<ConsistencyConfig>,
 }
 
 impl Default for SlamConfig {
@@ -205,6 +214,8 @@ impl Default for SlamConfig {
             solver: SolverConfig::default(),
             optimize_every_nodes: 50,
             reject_weight: 0.5,
+            tracking: TrackingGuardConfig::default(),
+            consistency: Some(ConsistencyConfig::default()),
         }
     }
 }
@@ -262,6 +273,10 @@ impl SlamConfig {
         }
         if let Some(l) = &self.loops {
             l.validate()?;
+        }
+        self.tracking.validate()?;
+        if let Some(c) = &self.consistency {
+            c.validate()?;
         }
         Ok(())
     }
