@@ -3,10 +3,12 @@
 use raypath_reflectivity::{MapConfig, MatcherConfig, PointFilter};
 use serde::{Deserialize, Serialize};
 
+use crate::consistency::ConsistencyConfig;
 use crate::correlative::CorrelativeConfig;
 use crate::error::{Result, SlamError, require_positive};
 use crate::global_search::GlobalSearchConfig;
 use crate::graph::SolverConfig;
+use crate::guard::TrackingGuardConfig;
 
 /// How scans become nodes and nodes fill submaps (the front-end).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -46,15 +48,6 @@ pub struct SubmapConfig {
     /// held-out logs of `docs/results/slam.md`, whose scans are up to 80° apart); at 10 Hz a
     /// raw log turns by at most a few degrees a scan, so its window hardly grows.
     pub rotation_window_growth: f64,
-    /// An odometry increment faster than this is a glitch, metres per second: only then is
-    /// the last scan's pose (no motion) searched as a second guess for a translation. Default
-    /// 2 m/s (ours): the benchmark robots drive below 1 m/s, and the raw MIT CSAIL log's
-    /// odometry jumps by 0.5–0.9 m within 0.2 s (2.5–4.5 m/s). A plain step is never
-    /// second-guessed: in a corridor without features along it the last pose fits the scan as
-    /// well as the true one, and taking it (the earlier rule, any step over two coarsest
-    /// cells) stopped the robot in corridors when scans were far apart. Without scan times
-    /// (equal stamps) no translation is second-guessed.
-    pub max_speed_mps: f64,
     /// Side of the square grid of one active submap, metres, centred on its first node. It
     /// must hold the points of every scan of the submap: at least twice the maximum range.
     /// Default 70 m (2 × 30 m range + 10 m of travel).
@@ -72,7 +65,6 @@ impl Default for SubmapConfig {
             rotation_step_rad: 1f64.to_radians(),
             rotation_min_gain: 0.03,
             rotation_window_growth: 0.3,
-            max_speed_mps: 2.0,
             size_m: 70.0,
         }
     }
@@ -215,6 +207,13 @@ pub struct SlamConfig {
     /// loop closures that the corrected log's own map refutes end well below it, right ones
     /// almost never (the wrong-loop counts are in `docs/results/slam.md`).
     pub reject_weight: f64,
+    /// The front-end's guards against odometry outliers and failed matches
+    /// ([`crate::guard`]).
+    pub tracking: TrackingGuardConfig,
+    /// The consistency test every loop candidate passes before it enters the pose graph
+    /// ([`crate::consistency`]); `None`: every verified match enters (the robust back-end alone
+    /// judges it). Default on.
+    pub consistency: Option<ConsistencyConfig>,
 }
 
 impl Default for SlamConfig {
@@ -231,6 +230,8 @@ impl Default for SlamConfig {
             solver: SolverConfig::default(),
             optimize_every_nodes: 50,
             reject_weight: 0.5,
+            tracking: TrackingGuardConfig::default(),
+            consistency: Some(ConsistencyConfig::default()),
         }
     }
 }
@@ -268,7 +269,6 @@ impl SlamConfig {
                 reason: format!("must lie in [0, 1], got {}", s.rotation_window_growth),
             });
         }
-        require_positive("max_speed_mps", s.max_speed_mps)?;
         if !(s.rotation_window_rad >= 0.0 && s.rotation_window_rad < std::f64::consts::PI) {
             return Err(SlamError::InvalidParameter {
                 name: "rotation_window_rad",
@@ -295,6 +295,10 @@ impl SlamConfig {
         }
         if let Some(l) = &self.loops {
             l.validate()?;
+        }
+        self.tracking.validate()?;
+        if let Some(c) = &self.consistency {
+            c.validate()?;
         }
         Ok(())
     }

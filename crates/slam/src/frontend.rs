@@ -17,6 +17,7 @@ use raypath_reflectivity::{GridLevel, MatcherConfig, Prior, ScanPoints, match_le
 
 use crate::config::{SlamConfig, information};
 use crate::error::Result;
+use crate::guard::{MatchStatus, TrackingGuardConfig, TrackingStats, judge, match_score};
 use crate::submap::{ActiveSubmap, Submap};
 
 /// The front-end state.
@@ -32,7 +33,18 @@ pub(crate) struct FrontEnd {
     rotation_step_rad: f64,
     rotation_min_gain: f64,
     rotation_window_growth: f64,
-    max_speed_mps: f64,
+    guard: TrackingGuardConfig,
+    last_stamp: Option<f64>,
+    /// Matches have failed for too long: the next insertion finishes the active submaps and
+    /// starts a new one.
+    break_pending: bool,
+    /// The last scan's match failed.
+    last_failed: bool,
+    /// Path since the last match that did not fail, metres.
+    failed_travel_m: f64,
+    /// A match failed since the last node.
+    failed_since_node: bool,
+    pub stats: TrackingStats,
 }
 
 impl FrontEnd {
@@ -51,7 +63,13 @@ impl FrontEnd {
             rotation_step_rad: config.submaps.rotation_step_rad,
             rotation_min_gain: config.submaps.rotation_min_gain,
             rotation_window_growth: config.submaps.rotation_window_growth,
-            max_speed_mps: config.submaps.max_speed_mps,
+            guard: config.tracking,
+            last_stamp: None,
+            break_pending: false,
+            last_failed: false,
+            failed_travel_m: 0.0,
+            failed_since_node: false,
+            stats: TrackingStats::default(),
         }
     }
 
@@ -60,24 +78,42 @@ impl FrontEnd {
         self.travel_m
     }
 
-    /// Matches a scan: `odometry` is the logged `world_from_sensor` of the odometry (or `None`
-    /// to predict no motion), `dt_secs` the time since the last scan (0 when unknown). Returns
-    /// the local pose and the matcher's covariance.
+    /// Whether a match failed since the last node (its sequential edge then carries the
+    /// odometry's uncertainty, [`TrackingGuardConfig::fallback_sigma`]).
+    pub fn failed_since_node(&self) -> bool {
+        self.failed_since_node
+    }
+
+    /// Matches a scan taken at `stamp_secs`: `odometry` is the logged `world_from_sensor` of
+    /// the odometry (or `None` to predict no motion). An implausible odometry increment is
+    /// replaced by no motion, and a failed match by the odometry guess (see [`crate::guard`]).
+    /// Returns the local pose.
     pub fn track(
         &mut self,
         points: &ScanPoints,
         odometry: Option<Pose2>,
-        dt_secs: f64,
-    ) -> (Pose2, Matrix3<f64>) {
-        let delta = match (self.last_odometry, odometry) {
+        stamp_secs: f64,
+    ) -> Pose2 {
+        let mut delta = match (self.last_odometry, odometry) {
             (Some(a), Some(b)) => a.inverse() * b,
             _ => Pose2::identity(),
         };
         if odometry.is_some() {
             self.last_odometry = odometry;
         }
+        let dt = self.last_stamp.map_or(f64::NAN, |t| stamp_secs - t);
+        self.last_stamp = Some(stamp_secs);
+        // An increment the robot cannot have driven is unknown: no motion is the guess, the
+        // logged increment only a second candidate (below).
+        let logged = delta;
+        let outlier = !self.guard.plausible(&delta, dt);
+        if outlier {
+            self.stats.odometry_outliers += 1;
+            delta = Pose2::identity();
+        }
         let guess = self.local * delta;
-        let (pose, covariance) = match self.active.front() {
+        let mut status = MatchStatus::Good;
+        let (pose, _covariance) = match self.active.front() {
             Some(submap) if !points.is_empty() => {
                 let submap_from_local = submap.local_from_submap.inverse();
                 let mut initial = submap_from_local * guess;
@@ -94,23 +130,33 @@ impl FrontEnd {
                             self.rotation_min_gain,
                         )
                     };
-                    let (from_odometry, score) = search(initial);
-                    initial = from_odometry;
+                    let (from_guess, score) = search(initial);
+                    initial = from_guess;
                     // A glitch in the odometry (a jump in the log, wheel slip) moves the guess
                     // out of every basin: when the increment turns beyond the search window,
-                    // or moves more than two coarsest cells faster than the robot can drive,
-                    // the pose of the last scan (no motion) is a second candidate, taken when
-                    // it scores clearly better.
+                    // or moves more than two coarsest cells faster than the robot can drive
+                    // ([`TrackingGuardConfig::max_speed_mps`], no allowance), the pose of the
+                    // last scan (no motion) is a second candidate, taken when it scores
+                    // clearly better. A plain step is never second-guessed: in a corridor
+                    // without features along it the last pose fits as well. For an implausible
+                    // increment the roles swap.
                     let coarsest = submap.map.levels().last().map_or(0.0, |l| l.resolution_m());
                     let step = delta.translation().norm();
-                    if delta.theta().abs() > window
-                        || (dt_secs > 0.0
-                            && step > 2.0 * coarsest
-                            && step > self.max_speed_mps * dt_secs)
-                    {
-                        let (standing, standing_score) = search(submap_from_local * self.local);
-                        if standing_score > score + self.rotation_min_gain {
-                            initial = standing;
+                    let too_fast = self
+                        .guard
+                        .max_speed_mps
+                        .is_some_and(|v| dt > 0.0 && step > 2.0 * coarsest && step > v * dt);
+                    let second = if outlier {
+                        Some(self.local * logged)
+                    } else if delta.theta().abs() > window || too_fast {
+                        Some(self.local)
+                    } else {
+                        None
+                    };
+                    if let Some(second) = second {
+                        let (alternative, alt_score) = search(submap_from_local * second);
+                        if alt_score > score + self.rotation_min_gain {
+                            initial = alternative;
                         }
                     }
                 }
@@ -125,17 +171,48 @@ impl FrontEnd {
                     initial,
                     prior.as_ref(),
                 );
-                (submap.local_from_submap * p, c)
+                let score = submap
+                    .map
+                    .levels()
+                    .first()
+                    .map_or(0.0, |l| match_score(l, points, &p));
+                let (kept, verdict) = judge(&self.guard, initial, p, &c, score);
+                status = verdict;
+                let kept = match verdict {
+                    MatchStatus::Failed => submap_from_local * guess,
+                    _ => kept,
+                };
+                (submap.local_from_submap * kept, c)
             }
             _ => (guess, Matrix3::from_diagonal_element(f64::INFINITY)),
         };
-        self.travel_m += (self.local.inverse() * pose).translation().norm();
+        let step = (self.local.inverse() * pose).translation().norm();
+        self.last_failed = status == MatchStatus::Failed;
+        match status {
+            MatchStatus::Good => self.failed_travel_m = 0.0,
+            MatchStatus::Degenerate => {
+                self.stats.degenerate += 1;
+                self.failed_travel_m = 0.0;
+            }
+            MatchStatus::Failed => {
+                self.stats.failed += 1;
+                self.failed_since_node = true;
+                self.failed_travel_m += step;
+                if self.failed_travel_m >= self.guard.max_failed_travel_m {
+                    self.break_pending = true;
+                }
+            }
+        }
+        self.travel_m += step;
         self.local = pose;
-        (pose, covariance)
+        pose
     }
 
     /// Whether the last tracked pose has moved far enough from the last node to become one.
     pub fn wants_node(&self, config: &SlamConfig) -> bool {
+        if self.break_pending {
+            return true;
+        }
         match self.last_node {
             None => true,
             Some(last) => {
@@ -158,6 +235,20 @@ impl FrontEnd {
         intra: &mut Vec<(usize, Pose2)>,
     ) -> Result<Vec<ActiveSubmap>> {
         let s = &config.submaps;
+        let mut finished = Vec::new();
+        if std::mem::take(&mut self.break_pending) {
+            // Matching has failed for too long: the active submaps end here and a new one
+            // starts at the odometry's pose.
+            finished.extend(self.active.drain(..));
+            self.stats.submap_breaks += 1;
+            self.failed_travel_m = 0.0;
+        } else if self.last_failed {
+            // No submap is built across a failed match: its scan is not inserted.
+            self.last_node = Some(self.local);
+            return Ok(finished);
+        }
+        // The edge into the next node is weak when this node's own match failed.
+        self.failed_since_node = self.last_failed;
         let start = match self.active.back() {
             None => true,
             Some(newest) => {
@@ -183,7 +274,6 @@ impl FrontEnd {
             }
         }
         self.last_node = Some(self.local);
-        let mut finished = Vec::new();
         while self.active.len() > 2
             || self
                 .active

@@ -124,19 +124,23 @@
 
 pub mod benchmark;
 mod config;
+pub mod consistency;
 pub mod correlative;
 mod error;
 mod frontend;
 pub mod global_search;
 pub mod graph;
+pub mod guard;
 mod loops;
 mod output;
 mod pipeline;
 mod submap;
 
 pub use config::{LoopSearchConfig, Sigmas, SlamConfig, SubmapConfig};
+pub use consistency::{ConsistencyConfig, ConsistencyStats};
 pub use error::{Result, SlamError};
 pub use global_search::GlobalSearchConfig;
+pub use guard::{MatchStatus, TrackingGuardConfig, TrackingStats};
 pub use loops::{LoopClosure, LoopSource, LoopStats};
 pub use output::{ScanPose, SlamOutput, SlamStats};
 pub use pipeline::Slam;

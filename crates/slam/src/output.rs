@@ -41,6 +41,10 @@ pub struct SlamStats {
     pub final_chi2: f64,
     /// Loop-search counters.
     pub loops: LoopStats,
+    /// Counters of the front-end's guards.
+    pub tracking: crate::guard::TrackingStats,
+    /// Counters of the loop consistency test.
+    pub consistency: crate::consistency::ConsistencyStats,
 }
 
 /// The result of [`crate::Slam::finish`].

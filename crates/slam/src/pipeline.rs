@@ -7,10 +7,11 @@ use raypath_io::sequence::PlanarFrame;
 use raypath_reflectivity::{IntensityCorrection, MatcherConfig, ScanPoints};
 
 use crate::config::{SlamConfig, information};
+use crate::consistency::{LoopCandidate, LoopGate, View};
 use crate::error::{Result, SlamError};
 use crate::frontend::{FrontEnd, freeze_all};
 use crate::graph::{Edge, EdgeKind, PoseGraph};
-use crate::loops::{LoopCloser, LoopClosure};
+use crate::loops::{LoopCloser, LoopClosure, LoopSource};
 use crate::output::{ScanPose, SlamOutput, SlamStats};
 use crate::submap::Submap;
 
@@ -39,6 +40,9 @@ pub struct Slam {
     loops_since_optimisation: usize,
     travel_at_last_loop: f64,
     stats: SlamStats,
+    /// The loop consistency test ([`crate::consistency`]); held candidates carry
+    /// `(submap, score, source)`.
+    gate: Option<LoopGate<(usize, f64, LoopSource)>>,
 }
 
 impl Slam {
@@ -50,6 +54,7 @@ impl Slam {
             None => None,
         };
         Ok(Self {
+            gate: config.consistency.map(LoopGate::new),
             matcher: config.matcher,
             frontend: FrontEnd::new(&config),
             loops,
@@ -92,6 +97,11 @@ impl Slam {
         self.node_local.len()
     }
 
+    /// The submaps finished so far (indices for [`Slam::propose_loop_closure`]).
+    pub fn submaps(&self) -> &[Submap] {
+        &self.submaps
+    }
+
     /// The current estimate of the latest scan's `world_from_sensor`.
     pub fn pose(&self) -> Option<Pose2> {
         self.scans.last().map(|s| self.world_from_local() * s.local)
@@ -127,11 +137,7 @@ impl Slam {
         let t0 = Instant::now();
         self.points
             .fill_from_scan(scan, &self.config.filter, self.correction.as_ref());
-        let dt_secs = self
-            .scans
-            .last()
-            .map_or(0.0, |last| (stamp_secs - last.stamp_secs).max(0.0));
-        let (local, _) = self.frontend.track(&self.points, odometry, dt_secs);
+        let local = self.frontend.track(&self.points, odometry, stamp_secs);
         let node = if self.frontend.wants_node(&self.config) {
             Some(self.add_node(stamp_secs, local)?)
         } else {
@@ -169,15 +175,24 @@ impl Slam {
         let world = self.world_from_local() * local;
         let node = self.graph.add_node(world);
         if let Some(&prev) = self.node_local.last() {
+            // Across a failed match the step is the odometry's, with its uncertainty.
+            let sigma = if self.frontend.failed_since_node() {
+                &self.config.tracking.fallback_sigma
+            } else {
+                &self.config.sequential_sigma
+            };
             self.graph.add_edge(Edge {
                 from: node - 1,
                 to: node,
                 measurement: prev.inverse() * local,
-                information: information(&self.config.sequential_sigma),
+                information: information(sigma),
                 kind: EdgeKind::Sequential,
             })?;
         }
         self.node_local.push(local);
+        if let Some(gate) = self.gate.as_mut() {
+            gate.add_node(node, self.frontend.travel_m());
+        }
         self.node_scan.push(self.scans.len());
         self.node_submap.push(None);
         let mut intra = Vec::with_capacity(2);
@@ -230,31 +245,86 @@ impl Slam {
             travel,
         );
         for (submap, submap_from_sensor, score, source) in found {
-            let Some(anchor) = self.submaps.get(submap).map(Submap::anchor) else {
-                continue;
-            };
+            self.propose_loop(node, submap, submap_from_sensor, score, source);
+        }
+        self.stats.loop_seconds += t0.elapsed().as_secs_f64();
+    }
+
+    /// Proposes a loop closure of the latest node: seen at `submap_from_sensor` in finished
+    /// submap `submap` (an index into the submaps finished so far) with match score `score`.
+    /// It passes the same consistency test as the loop search's own matches
+    /// ([`SlamConfig::consistency`]) before it enters the pose graph, so an external loop
+    /// source (or a test) can offer loops without being trusted blindly. Returns whether it
+    /// entered now (a held candidate may enter later, with a supporting one).
+    pub fn propose_loop_closure(
+        &mut self,
+        submap: usize,
+        submap_from_sensor: Pose2,
+        score: f64,
+        source: LoopSource,
+    ) -> bool {
+        let Some(node) = self.node_local.len().checked_sub(1) else {
+            return false;
+        };
+        self.propose_loop(node, submap, submap_from_sensor, score, source)
+    }
+
+    /// Tests a loop candidate and adds the edges of the ones that enter; whether it did.
+    fn propose_loop(
+        &mut self,
+        node: usize,
+        submap: usize,
+        submap_from_sensor: Pose2,
+        score: f64,
+        source: LoopSource,
+    ) -> bool {
+        let Some(anchor) = self.submaps.get(submap).map(Submap::anchor) else {
+            return false;
+        };
+        let candidate = LoopCandidate {
+            node,
+            anchor,
+            anchor_from_node: submap_from_sensor,
+        };
+        let entering = match self.gate.as_mut() {
+            Some(gate) => {
+                let view = View {
+                    graph: &self.graph,
+                    local: &self.node_local,
+                    reject_weight: self.config.reject_weight,
+                };
+                gate.check(candidate, (submap, score, source), &view)
+            }
+            None => vec![(candidate, (submap, score, source))],
+        };
+        let mut entered = false;
+        for (c, (submap, score, source)) in entering {
             let edge = Edge {
-                from: anchor,
-                to: node,
-                measurement: submap_from_sensor,
+                from: c.anchor,
+                to: c.node,
+                measurement: c.anchor_from_node,
                 information: information(&self.config.loop_sigma),
                 kind: EdgeKind::Loop,
             };
             if let Ok(edge) = self.graph.add_edge(edge) {
+                if let Some(gate) = self.gate.as_mut() {
+                    gate.accepted(c, edge);
+                }
                 self.closures.push(LoopClosure {
-                    node,
+                    node: c.node,
                     submap,
-                    anchor,
-                    submap_from_sensor,
+                    anchor: c.anchor,
+                    submap_from_sensor: c.anchor_from_node,
                     score,
                     source,
                     edge,
                 });
                 self.loops_since_optimisation += 1;
                 self.travel_at_last_loop = self.frontend.travel_m();
+                entered |= c == candidate;
             }
         }
-        self.stats.loop_seconds += t0.elapsed().as_secs_f64();
+        entered
     }
 
     fn optimise(&mut self) -> Result<()> {
@@ -262,6 +332,9 @@ impl Slam {
         let report = self.graph.optimize(&self.config.solver)?;
         self.stats.optimisations += 1;
         self.stats.final_chi2 = report.final_chi2;
+        if let Some(gate) = self.gate.as_mut() {
+            gate.optimised();
+        }
         self.nodes_since_optimisation = 0;
         self.loops_since_optimisation = 0;
         self.stats.optimise_seconds += t0.elapsed().as_secs_f64();
@@ -302,6 +375,8 @@ impl Slam {
             .collect();
         let stats = SlamStats {
             loops: loop_stats,
+            tracking: self.frontend.stats,
+            consistency: self.gate.as_ref().map(|g| g.stats).unwrap_or_default(),
             ..self.stats
         };
         Ok(SlamOutput {

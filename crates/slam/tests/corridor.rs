@@ -77,9 +77,9 @@ fn bad_front_end_settings_are_errors_naming_the_field() {
             c.submaps.rotation_window_growth = -0.1;
             c
         }),
-        ("max_speed_mps", {
+        ("tracking.max_speed_mps", {
             let mut c = SlamConfig::default();
-            c.submaps.max_speed_mps = f64::NAN;
+            c.tracking.max_speed_mps = Some(f64::NAN);
             c
         }),
     ] {
