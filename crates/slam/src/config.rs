@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 use crate::correlative::CorrelativeConfig;
 use crate::error::{Result, SlamError, require_positive};
 use crate::graph::SolverConfig;
+use crate::polish::PolishConfig;
 
 /// How scans become nodes and nodes fill submaps (the front-end).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -189,6 +190,10 @@ pub struct SlamConfig {
     /// loop closures that the corrected log's own map refutes end well below it, right ones
     /// almost never (the wrong-loop counts are in `docs/results/slam.md`).
     pub reject_weight: f64,
+    /// The final polishing after the last optimisation ([`crate::polish`]): every scan
+    /// aligned by point-to-line ICP to its next scans, and one pose graph over all scans
+    /// solved (`None`: off; the scans between nodes then keep the front-end's placement).
+    pub polish: Option<PolishConfig>,
 }
 
 impl Default for SlamConfig {
@@ -205,6 +210,7 @@ impl Default for SlamConfig {
             solver: SolverConfig::default(),
             optimize_every_nodes: 50,
             reject_weight: 0.5,
+            polish: Some(PolishConfig::default()),
         }
     }
 }
@@ -262,6 +268,9 @@ impl SlamConfig {
         }
         if let Some(l) = &self.loops {
             l.validate()?;
+        }
+        if let Some(p) = &self.polish {
+            p.validate()?;
         }
         Ok(())
     }

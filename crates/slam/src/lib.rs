@@ -125,6 +125,7 @@ pub mod graph;
 mod loops;
 mod output;
 mod pipeline;
+pub mod polish;
 mod submap;
 
 pub use config::{LoopSearchConfig, Sigmas, SlamConfig, SubmapConfig};
@@ -132,4 +133,5 @@ pub use error::{Result, SlamError};
 pub use loops::{LoopClosure, LoopSource, LoopStats};
 pub use output::{ScanPose, SlamOutput, SlamStats};
 pub use pipeline::Slam;
+pub use polish::PolishConfig;
 pub use submap::Submap;
