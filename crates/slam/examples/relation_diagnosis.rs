@@ -36,6 +36,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let (Some(p), Ok(v)) = (config.polish.as_mut(), std::env::var("POLISH_N")) {
         p.neighbours = v.parse()?;
     }
+    if let (Some(p), Ok(v)) = (config.polish.as_mut(), std::env::var("POLISH_REV")) {
+        p.revisits = v.parse()?;
+    }
     if let (Some(p), Ok(v)) = (config.polish.as_mut(), std::env::var("POLISH_EFF")) {
         p.effective_points = v.parse()?;
     }

@@ -144,7 +144,10 @@ fn polishing_removes_centimetre_errors_between_scans() {
         node_local: &noisy,
     };
     let weak = Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, 10.0));
-    let config = PolishConfig::default();
+    let config = PolishConfig {
+        neighbours: 2,
+        ..PolishConfig::default()
+    };
     let (polished, edges) = polish(
         &noisy,
         &points,
