@@ -308,7 +308,14 @@ fn polishing_lowers_the_relation_error_against_the_truth() {
         &truth,
         &odo,
     );
-    let polished = run(SlamConfig::default(), &truth, &odo);
+    let polished = run(
+        SlamConfig {
+            polish: Some(raypath_slam::PolishConfig::default()),
+            ..SlamConfig::default()
+        },
+        &truth,
+        &odo,
+    );
     assert!(polished.stats.polish_edges > truth.len());
     let reference: Vec<Option<Pose2>> = truth.iter().copied().map(Some).collect();
     let all: Vec<usize> = (0..truth.len()).collect();

@@ -30,13 +30,13 @@ use crate::graph::{Edge, EdgeKind, PoseGraph, SolverConfig};
 use crate::output::ScanPose;
 use icp::LineTarget;
 
-/// Settings of the polishing stage ([`crate::SlamConfig::polish`]); the defaults are ours,
-/// chosen on the Intel and MIT CSAIL logs' relation files (fr079 held out).
+/// Settings of the polishing stage ([`crate::SlamConfig::polish`], off by default); the
+/// defaults are ours, chosen on the Intel and MIT CSAIL logs' relation files (fr079 held out).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PolishConfig {
-    /// Each scan is aligned to this many following scans. Default 1: on the Intel log 2
-    /// lowered the relation-file error a little further (1.50 → 1.44 cm; MIT CSAIL 2.73 →
-    /// 2.69 cm) at twice the alignments; 1 keeps the stage cheap.
+    /// Each scan is aligned to this many following scans. Default 1: in our runs on Intel and
+    /// MIT CSAIL, 2 lowered the relation-file errors a little further at twice the
+    /// alignments; 1 keeps the stage cheap.
     pub neighbours: usize,
     /// Correspondence gates of the ICP stages, metres, narrowing. Default 0.15, 0.05 (the
     /// optimised poses are within centimetres of each other's alignment).
