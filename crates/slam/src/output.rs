@@ -35,6 +35,10 @@ pub struct SlamStats {
     pub loop_seconds: f64,
     /// Time in pose-graph optimisation, seconds.
     pub optimise_seconds: f64,
+    /// Time in the final polishing ([`crate::SlamConfig::polish`]), seconds.
+    pub polish_seconds: f64,
+    /// ICP edges of the final polishing.
+    pub polish_edges: usize,
     /// Number of optimisations.
     pub optimisations: usize,
     /// Final χ² of the last optimisation.

@@ -13,6 +13,7 @@ use crate::frontend::{FrontEnd, freeze_all};
 use crate::graph::{Edge, EdgeKind, PoseGraph};
 use crate::loops::{LoopCloser, LoopClosure, LoopSource};
 use crate::output::{ScanPose, SlamOutput, SlamStats};
+use crate::polish::{ScanNodes, polish};
 use crate::submap::Submap;
 
 /// Online 2-D SLAM over a stream of planar scans (see the crate docs for the pipeline).
@@ -36,6 +37,8 @@ pub struct Slam {
     closures: Vec<LoopClosure>,
     scans: Vec<ScanPose>,
     points: ScanPoints,
+    /// Every scan's points (sensor frame), kept for [`SlamConfig::polish`].
+    polish_points: Vec<Vec<[f64; 2]>>,
     nodes_since_optimisation: usize,
     loops_since_optimisation: usize,
     travel_at_last_loop: f64,
@@ -68,6 +71,7 @@ impl Slam {
             closures: Vec::new(),
             scans: Vec::new(),
             points: ScanPoints::new(),
+            polish_points: Vec::new(),
             nodes_since_optimisation: 0,
             loops_since_optimisation: 0,
             travel_at_last_loop: 0.0,
@@ -137,6 +141,9 @@ impl Slam {
         let t0 = Instant::now();
         self.points
             .fill_from_scan(scan, &self.config.filter, self.correction.as_ref());
+        if self.config.polish.is_some() {
+            self.polish_points.push(self.points.points().to_vec());
+        }
         let local = self.frontend.track(&self.points, odometry, stamp_secs);
         let node = if self.frontend.wants_node(&self.config) {
             Some(self.add_node(stamp_secs, local)?)
@@ -364,8 +371,8 @@ impl Slam {
             }
             self.optimise()?;
         }
-        let nodes = self.graph.nodes().to_vec();
-        let world_from_sensor = self
+        let mut nodes = self.graph.nodes().to_vec();
+        let mut world_from_sensor: Vec<Pose2> = self
             .scans
             .iter()
             .map(|s| match (nodes.get(s.node), self.node_local.get(s.node)) {
@@ -373,6 +380,33 @@ impl Slam {
                 _ => s.local,
             })
             .collect();
+        if let Some(config) = &self.config.polish {
+            let t0 = Instant::now();
+            let scan_nodes = ScanNodes {
+                scans: &self.scans,
+                node_scan: &self.node_scan,
+                node_local: &self.node_local,
+            };
+            let sequential = information(&self.config.sequential_sigma);
+            let (polished, edges) = polish(
+                &world_from_sensor,
+                &self.polish_points,
+                &self.graph,
+                &scan_nodes,
+                &sequential,
+                config,
+                &self.config.solver,
+            )?;
+            world_from_sensor = polished;
+            nodes = self
+                .node_scan
+                .iter()
+                .zip(&nodes)
+                .map(|(&k, &n)| world_from_sensor.get(k).copied().unwrap_or(n))
+                .collect();
+            self.stats.polish_edges = edges;
+            self.stats.polish_seconds = t0.elapsed().as_secs_f64();
+        }
         let stats = SlamStats {
             loops: loop_stats,
             tracking: self.frontend.stats,

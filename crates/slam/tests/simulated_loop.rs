@@ -290,3 +290,45 @@ fn submap_disagreement_sees_a_broken_loop() {
         "closed loop {consistent}, broken {inconsistent}"
     );
 }
+
+/// The final polishing (ICP between neighbouring scans and revisits, one pose graph over all
+/// scans) brings the relative poses of the scans closer to the simulator's truth than the
+/// front-end and node graph leave them: consecutive relations and random pairs across the
+/// loop both.
+#[test]
+fn polishing_lowers_the_relation_error_against_the_truth() {
+    use raypath_slam::benchmark::{consecutive_relations, random_relations, relation_errors};
+    let truth = path(2);
+    let odo = odometry(&truth, 0.03);
+    let unpolished = run(
+        SlamConfig {
+            polish: None,
+            ..SlamConfig::default()
+        },
+        &truth,
+        &odo,
+    );
+    let polished = run(
+        SlamConfig {
+            polish: Some(raypath_slam::PolishConfig::default()),
+            ..SlamConfig::default()
+        },
+        &truth,
+        &odo,
+    );
+    assert!(polished.stats.polish_edges > truth.len());
+    let reference: Vec<Option<Pose2>> = truth.iter().copied().map(Some).collect();
+    let all: Vec<usize> = (0..truth.len()).collect();
+    for (name, relations) in [
+        ("consecutive", consecutive_relations(&all)),
+        ("random", random_relations(&all, 500, 3)),
+    ] {
+        let before = relation_errors(&reference, &unpolished.world_from_sensor, &relations);
+        let after = relation_errors(&reference, &polished.world_from_sensor, &relations);
+        assert!(
+            after.trans_error_m < 0.7 * before.trans_error_m
+                && after.rot_error_deg <= before.rot_error_deg,
+            "{name}: before {before:?}, after {after:?}"
+        );
+    }
+}
