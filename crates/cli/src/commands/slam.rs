@@ -236,6 +236,7 @@ fn write_outputs(
         let source = match c.source {
             raypath_slam::LoopSource::Nearby => "nearby",
             raypath_slam::LoopSource::PlaceRecognition => "place-recognition",
+            raypath_slam::LoopSource::Global => "global",
         };
         text.push_str(&format!(
             "{scan},{anchor},{},{},{},{},{},{},{source}\n",
