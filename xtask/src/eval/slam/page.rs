@@ -474,6 +474,8 @@ mod tests {
             seconds: 2.0,
             scans: 500,
             benchmark: None,
+            benchmark_local: None,
+            benchmark_across: None,
         };
         let json = row_json("intel", "raypath-slam", &s);
         let md = scored("log", "method", std::slice::from_ref(&json)).unwrap();
@@ -527,6 +529,8 @@ mod tests {
             seconds: 2.0,
             scans: 500,
             benchmark: Some(summary(0.025, 700)),
+            benchmark_local: Some(summary(0.02, 650)),
+            benchmark_across: Some(summary(0.09, 50)),
         };
         let refinement = json!({
             "log": "intel", "consecutive": 100, "kept": 80, "reference_moved_m": 0.025,
@@ -548,6 +552,15 @@ mod tests {
             "noisy_reference_error": summary(0.028, 100),
             "noisy_kept": 88, "noisy_refined_error": summary(0.003, 88),
         });
+        let scored = |t: f64, share: f64| {
+            json!({ "consecutive": summary(t, 439), "random_pairs": summary(10.0 * t, 1000),
+                    "broken_share": share })
+        };
+        let held_out = json!({
+            "log": "aces", "scans": 440, "odometry": scored(0.07, 0.8), "slam": scored(0.04, 0.25),
+            "loop_closures": 5, "rejected_loop_closures": 9, "disagreement": 0.1,
+            "seconds": 7.5, "map": "held-out-aces.png",
+        });
         let ablation = json!({ "rows": [row_json("lab", "occupancy", &s)],
                                "notes": ["`indoor/lab` has no remissions"],
                                "refinement_check": check });
@@ -558,13 +571,16 @@ mod tests {
                 json!({ "skipped": "fr079 skipped." }),
             ),
             ("unreferenced/malaga-telecom".to_owned(), unreferenced),
+            ("held-out/aces".to_owned(), held_out),
             ("ablation/lab".to_owned(), ablation),
         ];
         let ctx = EvalContext::scratch(&std::env::temp_dir().join("raypath-slam-report-test"));
         let page = report(&ctx, &results).unwrap();
         let md = &page.markdown;
         let skip = md.find("* fr079 skipped.").expect("skip note");
-        assert!(skip < md.find("| intel ").unwrap(), "{md}");
+        let diagnostics = md.find("## Diagnostics").expect("diagnostics section");
+        let first_row = diagnostics + md[diagnostics..].find("| intel ").unwrap();
+        assert!(diagnostics < skip && skip < first_row, "{md}");
         assert!(md.contains("| malaga-telecom | 9000 "), "{md}");
         assert!(md.contains("| 5.00 % "), "{md}");
         assert!(
@@ -581,11 +597,36 @@ mod tests {
         );
         let intel = md
             .lines()
-            .find(|l| l.starts_with("| intel ") && l.contains("0.0229 ± 0.0239"))
+            .find(|l| {
+                l.starts_with("| intel ") && l.contains("scan-refined")
+                    || l.starts_with("| intel ") && l.contains("benchmark relations column")
+            })
             .expect("published row");
         assert!(intel.contains("0.0250 ± 0.0125"), "{intel}");
         assert!(intel.contains("benchmark relations column: yes"), "{intel}");
         assert!(page.json["unreferenced"][0].get("submaps").is_none());
+        // The headline: the relation file beside the published figures.
+        assert_eq!(
+            page.headline.as_deref(),
+            Some(
+                "raypath-slam on the SLAM benchmark's own relation files (like for like, mean \
+                 translational error): intel 0.0250 m (best published 0.0229 m, Cartographer)"
+            )
+        );
+        let head = md
+            .lines()
+            .find(|l| l.starts_with("| intel ") && l.contains("above: 1.09× Cartographer"))
+            .expect("headline row");
+        assert!(head.contains("0.0200 (650) / 0.0900 (50)"), "{head}");
+        // The held-out log: its row with the broken share and its map.
+        let aces = md
+            .lines()
+            .find(|l| l.starts_with("| aces "))
+            .expect("held-out row");
+        assert!(
+            aces.contains("| 25.0 % |") && aces.contains("held-out-aces.png"),
+            "{aces}"
+        );
         // The refinement tables: the real log's and the simulated check.
         let flat = md.split_whitespace().collect::<Vec<_>>().join(" ");
         assert!(
