@@ -597,10 +597,7 @@ mod tests {
         );
         let intel = md
             .lines()
-            .find(|l| {
-                l.starts_with("| intel ") && l.contains("scan-refined")
-                    || l.starts_with("| intel ") && l.contains("benchmark relations column")
-            })
+            .find(|l| l.starts_with("| intel ") && l.contains("benchmark relations column"))
             .expect("published row");
         assert!(intel.contains("0.0250 ± 0.0125"), "{intel}");
         assert!(intel.contains("benchmark relations column: yes"), "{intel}");
