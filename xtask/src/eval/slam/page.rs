@@ -442,206 +442,6 @@ fn published(md: &mut String, rows: &[Value]) -> Result<()> {
     Ok(())
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::eval::slam::{Scored, row_json};
-
-    fn summary(trans: f64, relations: usize) -> ErrorSummary {
-        ErrorSummary {
-            trans_error_m: trans,
-            trans_error_std_m: trans / 2.0,
-            rot_error_deg: 0.5,
-            rot_error_std_deg: 0.25,
-            relations,
-        }
-    }
-
-    /// One row: the cells and the JSON the published table reads back.
-    #[test]
-    fn row_and_published_table_from_known_scores() {
-        let s = Scored {
-            consecutive: summary(0.03, 100),
-            supported: summary(0.02, 97),
-            refined: summary(0.01, 80),
-            random: summary(0.2, 1000),
-            loops: 12,
-            rejected: 3,
-            wrong: 2,
-            wrong_nearest: 3,
-            disputed: 1,
-            checked: 11,
-            seconds: 2.0,
-            scans: 500,
-            benchmark: None,
-            benchmark_local: None,
-            benchmark_across: None,
-        };
-        let json = row_json("intel", "raypath-slam", &s);
-        let md = scored("log", "method", std::slice::from_ref(&json)).unwrap();
-        let cells: Vec<&str> = md
-            .lines()
-            .last()
-            .unwrap()
-            .split('|')
-            .map(str::trim)
-            .collect();
-        assert_eq!(cells[3], "100");
-        assert_eq!(cells[4], "0.0300 ± 0.0150");
-        assert_eq!(cells[6], "0.0200 ± 0.0100 (97 of 100)");
-        assert_eq!(cells[7], "0.0100 ± 0.0050 (80 of 100)");
-        assert_eq!(cells[9], "12 / 3");
-        assert_eq!(
-            cells[10],
-            "2 of 11 (1 at a disputed reference; nearest node: 3)"
-        );
-        assert_eq!(cells[12], "250");
-        let mut page = String::new();
-        published(&mut page, &[json]).unwrap();
-        let intel = page.lines().find(|l| l.starts_with("| intel")).unwrap();
-        assert!(intel.contains("0.0300 ± 0.0150") && intel.contains("0.0200 ± 0.0100"));
-        assert!(intel.contains("0.0100 ± 0.0050"), "scan-refined: {intel}");
-        assert!(
-            intel.contains("0.0229 ± 0.0239"),
-            "Cartographer's figure: {intel}"
-        );
-        let fr079 = page.lines().find(|l| l.starts_with("| fr079")).unwrap();
-        assert!(fr079.contains("not run"), "{fr079}");
-        assert!(page.lines().filter(|l| l.contains("| no:")).count() == 3);
-        assert!(intel.contains("— (no relation file)"), "{intel}");
-    }
-
-    /// The page from one unit of each kind and a skipped one: every table has its row, the
-    /// skip and no-remission notes stand before their tables, the JSON keeps its sections.
-    #[test]
-    fn report_from_known_units() {
-        let s = Scored {
-            consecutive: summary(0.03, 100),
-            supported: summary(0.02, 97),
-            refined: summary(0.01, 80),
-            random: summary(0.2, 1000),
-            loops: 12,
-            rejected: 3,
-            wrong: 0,
-            wrong_nearest: 1,
-            disputed: 0,
-            checked: 11,
-            seconds: 2.0,
-            scans: 500,
-            benchmark: Some(summary(0.025, 700)),
-            benchmark_local: Some(summary(0.02, 650)),
-            benchmark_across: Some(summary(0.09, 50)),
-        };
-        let refinement = json!({
-            "log": "intel", "consecutive": 100, "kept": 80, "reference_moved_m": 0.025,
-            "reference_moved_std_m": 0.01,
-            "dropped": { "ambiguous": 9, "unconstrained": 8, "unsupported": 1,
-                         "far_from_reference": 2, "unaligned": 0 },
-        });
-        let referenced = json!({ "rows": [row_json("intel", "raypath-slam", &s)],
-                                 "relation_file_unmatched": 4, "scan_refinement": refinement });
-        let unreferenced = json!({
-            "log": "malaga-telecom", "scans": 9000, "nodes": 2000, "submaps": 60,
-            "loop_closures": 40, "rejected_loop_closures": 2,
-            "disagreement_without_loops": 0.05, "disagreement": 0.01, "cells_compared": 1000,
-            "seconds": 30.0, "scans_per_second": 300.0, "map": "malaga-telecom.png",
-        });
-        let check = json!({
-            "world": "lab", "consecutive": 100, "noise_m": 0.02, "noise_deg": 0.3,
-            "exact_kept": 90, "exact_refined_error": summary(0.002, 90),
-            "noisy_reference_error": summary(0.028, 100),
-            "noisy_kept": 88, "noisy_refined_error": summary(0.003, 88),
-        });
-        let scored = |t: f64, share: f64| {
-            json!({ "consecutive": summary(t, 439), "random_pairs": summary(10.0 * t, 1000),
-                    "broken_share": share })
-        };
-        let held_out = json!({
-            "log": "aces", "scans": 440, "odometry": scored(0.07, 0.8), "slam": scored(0.04, 0.25),
-            "loop_closures": 5, "rejected_loop_closures": 9, "disagreement": 0.1,
-            "seconds": 7.5, "map": "held-out-aces.png",
-        });
-        let ablation = json!({ "rows": [row_json("lab", "occupancy", &s)],
-                               "notes": ["`indoor/lab` has no remissions"],
-                               "refinement_check": check });
-        let results = vec![
-            ("referenced/intel".to_owned(), referenced),
-            (
-                "referenced/fr079".to_owned(),
-                json!({ "skipped": "fr079 skipped." }),
-            ),
-            ("unreferenced/malaga-telecom".to_owned(), unreferenced),
-            ("held-out/aces".to_owned(), held_out),
-            ("ablation/lab".to_owned(), ablation),
-        ];
-        let ctx = EvalContext::scratch(&std::env::temp_dir().join("raypath-slam-report-test"));
-        let page = report(&ctx, &results).unwrap();
-        let md = &page.markdown;
-        let skip = md.find("* fr079 skipped.").expect("skip note");
-        let diagnostics = md.find("## Diagnostics").expect("diagnostics section");
-        let first_row = diagnostics + md[diagnostics..].find("| intel ").unwrap();
-        assert!(diagnostics < skip && skip < first_row, "{md}");
-        assert!(md.contains("| malaga-telecom | 9000 "), "{md}");
-        assert!(md.contains("| 5.00 % "), "{md}");
-        assert!(
-            md.contains("![malaga-telecom](slam/malaga-telecom.png)"),
-            "{md}"
-        );
-        assert!(md.contains("* `indoor/lab` has no remissions"), "{md}");
-        assert!(md.contains("| lab "), "{md}");
-        assert_eq!(page.json["referenced"][0]["loop_closures"], 12);
-        // The relation file's column and note, like for like only there.
-        assert!(
-            md.contains("found for intel (4 of its relations name no scan"),
-            "{md}"
-        );
-        let intel = md
-            .lines()
-            .find(|l| l.starts_with("| intel ") && l.contains("benchmark relations column"))
-            .expect("published row");
-        assert!(intel.contains("0.0250 ± 0.0125"), "{intel}");
-        assert!(intel.contains("benchmark relations column: yes"), "{intel}");
-        assert!(page.json["unreferenced"][0].get("submaps").is_none());
-        // The headline: the relation file beside the published figures.
-        assert_eq!(
-            page.headline.as_deref(),
-            Some(
-                "raypath-slam on the SLAM benchmark's own relation files (like for like, mean \
-                 translational error): intel 0.0250 m (best published 0.0229 m, Cartographer)"
-            )
-        );
-        let head = md
-            .lines()
-            .find(|l| l.starts_with("| intel ") && l.contains("above: 1.09× Cartographer"))
-            .expect("headline row");
-        assert!(head.contains("0.0200 (650) / 0.0900 (50)"), "{head}");
-        // The held-out log: its row with the broken share and its map.
-        let aces = md
-            .lines()
-            .find(|l| l.starts_with("| aces "))
-            .expect("held-out row");
-        assert!(
-            aces.contains("| 25.0 % |") && aces.contains("held-out-aces.png"),
-            "{aces}"
-        );
-        // The refinement tables: the real log's and the simulated check.
-        let flat = md.split_whitespace().collect::<Vec<_>>().join(" ");
-        assert!(
-            flat.contains("| intel | 100 | 80 | 9 / 8 / 1 / 2 / 0 | 0.0250 ± 0.0100 |"),
-            "{md}"
-        );
-        assert!(
-            flat.contains("| lab | 100 | 90, 0.0020 ± 0.0010 m, 0.50 ± 0.25° |"),
-            "{md}"
-        );
-        assert!(
-            flat.contains("| 88, 0.0030 ± 0.0015 m, 0.50 ± 0.25° |"),
-            "{md}"
-        );
-        assert_eq!(page.json["residual_ablation"].as_array().unwrap().len(), 1);
-    }
-}
-
 /// `value[key]` as an error summary, `None` when absent or null.
 fn summary_opt(value: &Value, key: &str) -> Option<ErrorSummary> {
     serde_json::from_value(value.get(key)?.clone()).ok()
@@ -880,4 +680,204 @@ fn held_out_section(md: &mut String, units: &[&Value]) -> Result<Vec<Value>> {
     }
     let _ = writeln!(md, "{}", t.to_markdown()?);
     Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::slam::{Scored, row_json};
+
+    fn summary(trans: f64, relations: usize) -> ErrorSummary {
+        ErrorSummary {
+            trans_error_m: trans,
+            trans_error_std_m: trans / 2.0,
+            rot_error_deg: 0.5,
+            rot_error_std_deg: 0.25,
+            relations,
+        }
+    }
+
+    /// One row: the cells and the JSON the published table reads back.
+    #[test]
+    fn row_and_published_table_from_known_scores() {
+        let s = Scored {
+            consecutive: summary(0.03, 100),
+            supported: summary(0.02, 97),
+            refined: summary(0.01, 80),
+            random: summary(0.2, 1000),
+            loops: 12,
+            rejected: 3,
+            wrong: 2,
+            wrong_nearest: 3,
+            disputed: 1,
+            checked: 11,
+            seconds: 2.0,
+            scans: 500,
+            benchmark: None,
+            benchmark_local: None,
+            benchmark_across: None,
+        };
+        let json = row_json("intel", "raypath-slam", &s);
+        let md = scored("log", "method", std::slice::from_ref(&json)).unwrap();
+        let cells: Vec<&str> = md
+            .lines()
+            .last()
+            .unwrap()
+            .split('|')
+            .map(str::trim)
+            .collect();
+        assert_eq!(cells[3], "100");
+        assert_eq!(cells[4], "0.0300 ± 0.0150");
+        assert_eq!(cells[6], "0.0200 ± 0.0100 (97 of 100)");
+        assert_eq!(cells[7], "0.0100 ± 0.0050 (80 of 100)");
+        assert_eq!(cells[9], "12 / 3");
+        assert_eq!(
+            cells[10],
+            "2 of 11 (1 at a disputed reference; nearest node: 3)"
+        );
+        assert_eq!(cells[12], "250");
+        let mut page = String::new();
+        published(&mut page, &[json]).unwrap();
+        let intel = page.lines().find(|l| l.starts_with("| intel")).unwrap();
+        assert!(intel.contains("0.0300 ± 0.0150") && intel.contains("0.0200 ± 0.0100"));
+        assert!(intel.contains("0.0100 ± 0.0050"), "scan-refined: {intel}");
+        assert!(
+            intel.contains("0.0229 ± 0.0239"),
+            "Cartographer's figure: {intel}"
+        );
+        let fr079 = page.lines().find(|l| l.starts_with("| fr079")).unwrap();
+        assert!(fr079.contains("not run"), "{fr079}");
+        assert!(page.lines().filter(|l| l.contains("| no:")).count() == 3);
+        assert!(intel.contains("— (no relation file)"), "{intel}");
+    }
+
+    /// The page from one unit of each kind and a skipped one: every table has its row, the
+    /// skip and no-remission notes stand before their tables, the JSON keeps its sections.
+    #[test]
+    fn report_from_known_units() {
+        let s = Scored {
+            consecutive: summary(0.03, 100),
+            supported: summary(0.02, 97),
+            refined: summary(0.01, 80),
+            random: summary(0.2, 1000),
+            loops: 12,
+            rejected: 3,
+            wrong: 0,
+            wrong_nearest: 1,
+            disputed: 0,
+            checked: 11,
+            seconds: 2.0,
+            scans: 500,
+            benchmark: Some(summary(0.025, 700)),
+            benchmark_local: Some(summary(0.02, 650)),
+            benchmark_across: Some(summary(0.09, 50)),
+        };
+        let refinement = json!({
+            "log": "intel", "consecutive": 100, "kept": 80, "reference_moved_m": 0.025,
+            "reference_moved_std_m": 0.01,
+            "dropped": { "ambiguous": 9, "unconstrained": 8, "unsupported": 1,
+                         "far_from_reference": 2, "unaligned": 0 },
+        });
+        let referenced = json!({ "rows": [row_json("intel", "raypath-slam", &s)],
+                                 "relation_file_unmatched": 4, "scan_refinement": refinement });
+        let unreferenced = json!({
+            "log": "malaga-telecom", "scans": 9000, "nodes": 2000, "submaps": 60,
+            "loop_closures": 40, "rejected_loop_closures": 2,
+            "disagreement_without_loops": 0.05, "disagreement": 0.01, "cells_compared": 1000,
+            "seconds": 30.0, "scans_per_second": 300.0, "map": "malaga-telecom.png",
+        });
+        let check = json!({
+            "world": "lab", "consecutive": 100, "noise_m": 0.02, "noise_deg": 0.3,
+            "exact_kept": 90, "exact_refined_error": summary(0.002, 90),
+            "noisy_reference_error": summary(0.028, 100),
+            "noisy_kept": 88, "noisy_refined_error": summary(0.003, 88),
+        });
+        let scored = |t: f64, share: f64| {
+            json!({ "consecutive": summary(t, 439), "random_pairs": summary(10.0 * t, 1000),
+                    "broken_share": share })
+        };
+        let held_out = json!({
+            "log": "aces", "scans": 440, "odometry": scored(0.07, 0.8), "slam": scored(0.04, 0.25),
+            "loop_closures": 5, "rejected_loop_closures": 9, "disagreement": 0.1,
+            "seconds": 7.5, "map": "held-out-aces.png",
+        });
+        let ablation = json!({ "rows": [row_json("lab", "occupancy", &s)],
+                               "notes": ["`indoor/lab` has no remissions"],
+                               "refinement_check": check });
+        let results = vec![
+            ("referenced/intel".to_owned(), referenced),
+            (
+                "referenced/fr079".to_owned(),
+                json!({ "skipped": "fr079 skipped." }),
+            ),
+            ("unreferenced/malaga-telecom".to_owned(), unreferenced),
+            ("held-out/aces".to_owned(), held_out),
+            ("ablation/lab".to_owned(), ablation),
+        ];
+        let ctx = EvalContext::scratch(&std::env::temp_dir().join("raypath-slam-report-test"));
+        let page = report(&ctx, &results).unwrap();
+        let md = &page.markdown;
+        let skip = md.find("* fr079 skipped.").expect("skip note");
+        let diagnostics = md.find("## Diagnostics").expect("diagnostics section");
+        let first_row = diagnostics + md[diagnostics..].find("| intel ").unwrap();
+        assert!(diagnostics < skip && skip < first_row, "{md}");
+        assert!(md.contains("| malaga-telecom | 9000 "), "{md}");
+        assert!(md.contains("| 5.00 % "), "{md}");
+        assert!(
+            md.contains("![malaga-telecom](slam/malaga-telecom.png)"),
+            "{md}"
+        );
+        assert!(md.contains("* `indoor/lab` has no remissions"), "{md}");
+        assert!(md.contains("| lab "), "{md}");
+        assert_eq!(page.json["referenced"][0]["loop_closures"], 12);
+        // The relation file's column and note, like for like only there.
+        assert!(
+            md.contains("found for intel (4 of its relations name no scan"),
+            "{md}"
+        );
+        let intel = md
+            .lines()
+            .find(|l| l.starts_with("| intel ") && l.contains("benchmark relations column"))
+            .expect("published row");
+        assert!(intel.contains("0.0250 ± 0.0125"), "{intel}");
+        assert!(intel.contains("benchmark relations column: yes"), "{intel}");
+        assert!(page.json["unreferenced"][0].get("submaps").is_none());
+        // The headline: the relation file beside the published figures.
+        assert_eq!(
+            page.headline.as_deref(),
+            Some(
+                "raypath-slam on the SLAM benchmark's own relation files (like for like, mean \
+                 translational error): intel 0.0250 m (best published 0.0229 m, Cartographer)"
+            )
+        );
+        let head = md
+            .lines()
+            .find(|l| l.starts_with("| intel ") && l.contains("above: 1.09× Cartographer"))
+            .expect("headline row");
+        assert!(head.contains("0.0200 (650) / 0.0900 (50)"), "{head}");
+        // The held-out log: its row with the broken share and its map.
+        let aces = md
+            .lines()
+            .find(|l| l.starts_with("| aces "))
+            .expect("held-out row");
+        assert!(
+            aces.contains("| 25.0 % |") && aces.contains("held-out-aces.png"),
+            "{aces}"
+        );
+        // The refinement tables: the real log's and the simulated check.
+        let flat = md.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(
+            flat.contains("| intel | 100 | 80 | 9 / 8 / 1 / 2 / 0 | 0.0250 ± 0.0100 |"),
+            "{md}"
+        );
+        assert!(
+            flat.contains("| lab | 100 | 90, 0.0020 ± 0.0010 m, 0.50 ± 0.25° |"),
+            "{md}"
+        );
+        assert!(
+            flat.contains("| 88, 0.0030 ± 0.0015 m, 0.50 ± 0.25° |"),
+            "{md}"
+        );
+        assert_eq!(page.json["residual_ablation"].as_array().unwrap().len(), 1);
+    }
 }
