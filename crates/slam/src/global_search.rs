@@ -2,7 +2,7 @@
 //! loop closure over a long stretch of path (Hess et al. 2016, §V: the multi-resolution
 //! search makes windows of many metres affordable).
 //!
-//! The local search ([`crate::loops`]) looks around the node's estimate within a window of a
+//! The local search (`loops.rs`) looks around the node's estimate within a window of a
 //! few metres (at most [`LoopSearchConfig::max_linear_window_m`]). After a long path without a
 //! loop closure the estimate may be off by more than that: on the raw `ual-2014-05-23` log the
 //! end of the 524 m loop lies about 22 m (and 11°) from its start, and the local window (5 m) never

@@ -1,5 +1,5 @@
 //! Final polishing (ours): after the last optimisation of the node graph, every scan — not
-//! only the nodes — is aligned by point-to-line ICP ([`icp`]) to the next
+//! only the nodes — is aligned by point-to-line ICP (`icp.rs`) to the next
 //! [`PolishConfig::neighbours`] scans, each node's scan also to the scans of nodes that
 //! revisit its place ([`PolishConfig::revisits`]), and one pose graph over all scans is
 //! solved: the node graph's own edges (sequential, intra-submap, the accepted loop closures),
