@@ -1,6 +1,7 @@
 //! Scan-refined relations: reference relations refined by aligning their own two scans,
 //! kept where that alignment is unique and well constrained ([`refine_relations`]).
 
+use crate::polish::line_normal;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use nalgebra::{Matrix2, Matrix3, Point2, Vector2, Vector3};
 use raypath_geometry::{Pose2, Scan2};
@@ -350,27 +351,6 @@ impl Lines {
         }
         (h, g, scatter, used)
     }
-}
-
-/// The normal of the line through `points` (principal axes of their scatter), when they are
-/// at least three and line-like (the smaller eigenvalue below a tenth of the larger).
-fn line_normal(points: &[Vector2<f64>]) -> Option<Vector2<f64>> {
-    if points.len() < 3 {
-        return None;
-    }
-    let mean = points.iter().sum::<Vector2<f64>>() / points.len() as f64;
-    let scatter: Matrix2<f64> = points
-        .iter()
-        .map(|p| (p - mean) * (p - mean).transpose())
-        .sum();
-    let eig = scatter.symmetric_eigen();
-    let (small, large) = if eig.eigenvalues[0] <= eig.eigenvalues[1] {
-        (0, 1)
-    } else {
-        (1, 0)
-    };
-    (eig.eigenvalues[small] <= 0.1 * eig.eigenvalues[large] && eig.eigenvalues[large] > 0.0)
-        .then(|| eig.eigenvectors.column(small).into_owned())
 }
 
 /// The smaller eigenvalue of a 2 × 2 scatter as a share of its trace.

@@ -29,6 +29,7 @@ use crate::error::{Result, SlamError, require_positive};
 use crate::graph::{Edge, EdgeKind, PoseGraph, SolverConfig};
 use crate::output::ScanPose;
 use icp::LineTarget;
+pub(crate) use icp::line_normal;
 
 /// Settings of the polishing stage ([`crate::SlamConfig::polish`], off by default); the
 /// defaults are ours, chosen on the Intel and MIT CSAIL logs' relation files (fr079 held out).
