@@ -37,6 +37,52 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if flag("--no-loops") {
         config.loops = None;
     }
+    // Knobs for experiments: SLAM_NO_GATE (no loop consistency test), SLAM_CHI2,
+    // SLAM_SUPPORT, SLAM_REF_TRAVEL, SLAM_DRIFT_T, SLAM_DRIFT_R, SLAM_HOLD, SLAM_LSIG_T,
+    // SLAM_LSIG_R (degrees): the fields of `ConsistencyConfig`; SLAM_ROT_GROWTH, SLAM_REJECT,
+    // SLAM_ANNEAL (the annealing's `max_start`), SLAM_PHI (DCS Φ of loop edges).
+    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
+    if env("SLAM_NO_GATE").is_some() {
+        config.consistency = None;
+    }
+    if let Some(c) = config.consistency.as_mut() {
+        if let Some(v) = env("SLAM_CHI2") {
+            c.chi2_gate = v;
+        }
+        if let Some(v) = env("SLAM_SUPPORT") {
+            c.min_support = v as usize;
+        }
+        if let Some(v) = env("SLAM_REF_TRAVEL") {
+            c.reference_travel_m = v;
+        }
+        if let Some(v) = env("SLAM_DRIFT_T") {
+            c.drift[0] = v;
+        }
+        if let Some(v) = env("SLAM_DRIFT_R") {
+            c.drift[1] = v;
+        }
+        if let Some(v) = env("SLAM_HOLD") {
+            c.hold_travel_m = v;
+        }
+        if let Some(v) = env("SLAM_LSIG_T") {
+            c.loop_sigma[0] = v;
+        }
+        if let Some(v) = env("SLAM_LSIG_R") {
+            c.loop_sigma[1] = v.to_radians();
+        }
+    }
+    if let Some(v) = env("SLAM_ROT_GROWTH") {
+        config.submaps.rotation_window_growth = v;
+    }
+    if let Some(v) = env("SLAM_REJECT") {
+        config.reject_weight = v;
+    }
+    if let (Some(v), Some(a)) = (env("SLAM_ANNEAL"), config.solver.annealing.as_mut()) {
+        a.max_start = v;
+    }
+    if let Some(v) = env("SLAM_PHI") {
+        config.solver.loop_kernel = raypath_slam::graph::RobustKernel::Dcs { phi: v };
+    }
     let t0 = Instant::now();
     let mut slam = Slam::new(config)?;
     for f in &frames {

@@ -263,27 +263,27 @@ impl<T> LoopGate<T> {
         self.chi2(q, p, self.pair_travel(r, c), lever) <= self.config.chi2_gate
     }
 
-    /// The candidate against the graph's estimate of its node, with the drift since the
-    /// nearest loop whose correction the estimate already holds.
+    /// The candidate against the graph's estimate of its node, with the drift along the
+    /// shortest path from its anchor to its node that the graph's loops already hold.
     fn graph_consistent(&self, c: &LoopCandidate, view: &View<'_>) -> bool {
         let nodes = view.graph.nodes();
         let (Some(&xa), Some(&xn)) = (nodes.get(c.anchor), nodes.get(c.node)) else {
             return true;
         };
         let (tn, ta) = (self.t(c.node), self.t(c.anchor));
-        let optimised = self.accepted.iter().filter(|a| a.optimised);
-        // Node side: path since the last optimised loop; anchor side: path to the nearest end
-        // of an optimised loop. Never more than the path from the anchor to the node.
-        let node_side = optimised
-            .clone()
-            .map(|a| tn - self.t(a.loop_.node))
-            .filter(|d| *d >= 0.0)
-            .fold(f64::INFINITY, f64::min);
-        let anchor_side = optimised
-            .flat_map(|a| [a.loop_.node, a.loop_.anchor])
-            .map(|k| (self.t(k) - ta).abs())
-            .fold(f64::INFINITY, f64::min);
-        let d = (node_side + anchor_side).min(tn - ta).max(0.0);
+        // The drift enters over the shortest path from anchor to node through one optimised
+        // loop still in force (anchor → one end of the loop, other end → node), never more
+        // than the path from the anchor to the node itself.
+        let d = self
+            .accepted
+            .iter()
+            .filter(|a| a.optimised && view.graph.edge_weight(a.edge) >= view.reject_weight)
+            .map(|a| {
+                let (ln, la) = (self.t(a.loop_.node), self.t(a.loop_.anchor));
+                ((ta - la).abs() + (tn - ln).abs()).min((ta - ln).abs() + (tn - la).abs())
+            })
+            .fold((tn - ta).abs(), f64::min)
+            .max(0.0);
         let q = xa * c.anchor_from_node;
         let lever = c.anchor_from_node.translation().norm();
         self.chi2(q, xn, d, lever) <= self.config.chi2_gate

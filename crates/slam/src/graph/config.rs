@@ -23,7 +23,7 @@ pub struct SolverConfig {
     /// default solver for 2-D SLAM, Kümmerle et al. 2011).
     pub method: Method,
     /// Maximum number of iterations (linearisations). Default 20: the annealing schedule
-    /// takes at most 10, and the M3500-style graph of the benchmark converges in 11 from the
+    /// takes at most 17, and the M3500-style graph of the benchmark converges in 11 from the
     /// chained-odometry guess.
     pub max_iterations: usize,
     /// Kernel on [`EdgeKind::Loop`](super::EdgeKind::Loop) edges. Default
