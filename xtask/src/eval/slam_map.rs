@@ -1,6 +1,7 @@
 //! The map picture of `cargo xtask eval slam`: the finished submaps' finest levels painted at
 //! their optimised poses (grey unknown, white free, black occupied; later submaps over
-//! earlier ones where both are confident).
+//! earlier ones where both are confident), and in red the cells where two submaps of
+//! different visits disagree ([`raypath_slam::benchmark::disagreement_points`]).
 
 use std::path::Path;
 
@@ -12,7 +13,7 @@ const PIXEL_M: f64 = 0.1;
 /// Largest picture side, pixels.
 const MAX_SIDE: usize = 4000;
 
-/// Writes the map of `out` as a PNG.
+/// Writes the map of `out` as a PNG, the cells where its submaps disagree in red.
 pub fn write_png(out: &SlamOutput, path: &Path) -> Result<()> {
     // World positions of every submap's observed cells (log-odds, world x, world y).
     let mut cells: Vec<(f32, f64, f64)> = Vec::new();
@@ -55,15 +56,28 @@ pub fn write_png(out: &SlamOutput, path: &Path) -> Result<()> {
         let j = (((y1 - y) / PIXEL_M) as usize).min(h - 1);
         sum[j * w + i] += l.clamp(-2.0, 4.0);
     }
-    let img = image::GrayImage::from_fn(w as u32, h as u32, |i, j| {
-        let v = sum[j as usize * w + i as usize];
-        image::Luma([if v > 1.0 {
+    let mut red = vec![false; w * h];
+    for p in raypath_slam::benchmark::disagreement_points(out) {
+        if (x0..=x1).contains(&p.x) && (y0..=y1).contains(&p.y) {
+            let i = (((p.x - x0) / PIXEL_M) as usize).min(w - 1);
+            let j = (((y1 - p.y) / PIXEL_M) as usize).min(h - 1);
+            red[j * w + i] = true;
+        }
+    }
+    let img = image::RgbImage::from_fn(w as u32, h as u32, |i, j| {
+        let k = j as usize * w + i as usize;
+        if red[k] {
+            return image::Rgb([220, 0, 0]);
+        }
+        let v = sum[k];
+        let g = if v > 1.0 {
             0
         } else if v < -0.5 {
             255
         } else {
             200
-        }])
+        };
+        image::Rgb([g, g, g])
     });
     img.save(path)
         .with_context(|| format!("writing {}", path.display()))

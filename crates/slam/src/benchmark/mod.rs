@@ -262,10 +262,39 @@ impl PointIndex {
 /// thicker or thinner by the other visit (5 cm cells) from counting. Returns
 /// `(fraction, cells compared)`.
 pub fn submap_disagreement(output: &crate::SlamOutput) -> (f64, usize) {
+    let (mut conflicts, mut compared) = (0usize, 0usize);
+    visit_disagreement(output, |_, conflict| {
+        compared += 1;
+        conflicts += usize::from(conflict);
+    });
+    let fraction = if compared == 0 {
+        0.0
+    } else {
+        conflicts as f64 / compared as f64
+    };
+    (fraction, compared)
+}
+
+/// The world positions of the cells that [`submap_disagreement`] counts as disagreeing (a
+/// cell once per pair of submaps), for a picture of where a map disagrees with itself.
+pub fn disagreement_points(output: &crate::SlamOutput) -> Vec<nalgebra::Point2<f64>> {
+    let mut points = Vec::new();
+    visit_disagreement(output, |p, conflict| {
+        if conflict {
+            points.push(p);
+        }
+    });
+    points
+}
+
+/// Calls `visit(world point, disagrees)` for every cell [`submap_disagreement`] compares.
+fn visit_disagreement(
+    output: &crate::SlamOutput,
+    mut visit: impl FnMut(nalgebra::Point2<f64>, bool),
+) {
     const CONFIDENT: f32 = 2.0;
     let submaps = &output.submaps;
     let pose = |s: &crate::Submap| output.nodes.get(s.anchor()).copied();
-    let (mut conflicts, mut compared) = (0usize, 0usize);
     for (a, sa) in submaps.iter().enumerate() {
         let (Some(world_from_a), Some(la)) = (pose(sa), sa.levels().first()) else {
             continue;
@@ -301,21 +330,14 @@ pub fn submap_disagreement(output: &crate::SlamOutput) -> (f64, usize) {
                     };
                     let l = lb.log_odds(bi, bj);
                     if l.abs() > CONFIDENT {
-                        compared += 1;
-                        if l < -CONFIDENT && !occupied_near(lb, (bi, bj), near, CONFIDENT) {
-                            conflicts += 1;
-                        }
+                        let conflict =
+                            l < -CONFIDENT && !occupied_near(lb, (bi, bj), near, CONFIDENT);
+                        visit(world_from_a * p, conflict);
                     }
                 }
             }
         }
     }
-    let fraction = if compared == 0 {
-        0.0
-    } else {
-        conflicts as f64 / compared as f64
-    };
-    (fraction, compared)
 }
 
 /// How far a wall of one submap may lie from the other submap's wall on the same spot before

@@ -281,7 +281,9 @@ pub(super) fn report(ctx: &EvalContext, results: &UnitResults) -> Result<EvalRep
          the **submap disagreement**: of the confidently occupied cells of each finished submap \
          that fall on confidently observed cells of a submap of another visit (at the optimised \
          poses), the share the other submap sees as free with no wall of its own within 0.15 m. A broken or missed loop leaves walls \
-         in free space and raises it; compare with the same run without loop closure.\n"
+         in free space and raises it; compare with the same run without loop closure. In \
+         the pictures, those walls are red: where they line a corridor twice, a loop is \
+         open; scattered red is people, doors and glass seen by one visit only.\n"
     );
     let unreferenced = of_kind(results, "unreferenced/");
     notes(&mut md, &unreferenced);
