@@ -71,6 +71,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             c.loop_sigma[1] = v.to_radians();
         }
     }
+    if let Some(v) = env("SLAM_TRACK_SCORE") {
+        config.tracking.min_score = (v > 0.0).then_some(v);
+    }
+    if let Some(v) = env("SLAM_RANGE") {
+        config.filter.max_range_m = v;
+    }
     if let Some(v) = env("SLAM_ROT_GROWTH") {
         config.submaps.rotation_window_growth = v;
     }

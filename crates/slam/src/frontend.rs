@@ -17,7 +17,9 @@ use raypath_reflectivity::{GridLevel, MatcherConfig, Prior, ScanPoints, match_le
 
 use crate::config::{SlamConfig, information};
 use crate::error::Result;
-use crate::guard::{MatchStatus, TrackingGuardConfig, TrackingStats, judge, match_score};
+use crate::guard::{
+    MatchStatus, TrackingGuardConfig, TrackingStats, judge, match_score, update_recent_speed,
+};
 use crate::submap::{ActiveSubmap, Submap};
 
 /// The front-end state.
@@ -35,6 +37,8 @@ pub(crate) struct FrontEnd {
     rotation_window_growth: f64,
     guard: TrackingGuardConfig,
     last_stamp: Option<f64>,
+    /// The odometry's recent speed, m/s ([`TrackingGuardConfig::recent_speed_factor`]).
+    recent_speed_mps: f64,
     /// Matches have failed for too long: the next insertion finishes the active submaps and
     /// starts a new one.
     break_pending: bool,
@@ -65,6 +69,7 @@ impl FrontEnd {
             rotation_window_growth: config.submaps.rotation_window_growth,
             guard: config.tracking,
             last_stamp: None,
+            recent_speed_mps: 0.0,
             break_pending: false,
             last_failed: false,
             failed_travel_m: 0.0,
@@ -106,10 +111,13 @@ impl FrontEnd {
         // An increment the robot cannot have driven is unknown: no motion is the guess, the
         // logged increment only a second candidate (below).
         let logged = delta;
-        let outlier = !self.guard.plausible(&delta, dt);
+        let outlier = !self.guard.plausible(&delta, dt, self.recent_speed_mps);
         if outlier {
             self.stats.odometry_outliers += 1;
             delta = Pose2::identity();
+        } else {
+            self.recent_speed_mps =
+                update_recent_speed(self.recent_speed_mps, delta.translation().norm(), dt);
         }
         let guess = self.local * delta;
         let mut status = MatchStatus::Good;
@@ -144,7 +152,7 @@ impl FrontEnd {
                     let step = delta.translation().norm();
                     let too_fast = self
                         .guard
-                        .max_speed_mps
+                        .speed_bound(self.recent_speed_mps)
                         .is_some_and(|v| dt > 0.0 && step > 2.0 * coarsest && step > v * dt);
                     let second = if outlier {
                         Some(self.local * logged)

@@ -64,6 +64,12 @@ pub struct TrackingGuardConfig {
     /// a corridor without features along it the last pose fits the scan as well, and with
     /// scans far apart the robot stood still; `tests/corridor.rs`).
     pub max_speed_mps: Option<f64>,
+    /// The speed bound grows with the speed the odometry has shown lately: it is the larger
+    /// of [`max_speed_mps`](Self::max_speed_mps) and this factor times the recent speed (an
+    /// average of the plausible increments over the last [`SPEED_WINDOW_S`]). Default 2
+    /// (ours): an outdoor vehicle at 3–5 m/s (the raw UAL campus log) is not an outlier
+    /// throughout, and a jump of a metre between scans still is.
+    pub recent_speed_factor: f64,
     /// … or turning faster than this, rad/s. Default 3 rad/s (ours, as above).
     pub max_turn_rate_rad_s: f64,
     /// Allowance added to both bounds, for time-stamp jitter: `(metres, radians)`. Default
@@ -89,6 +95,7 @@ impl Default for TrackingGuardConfig {
             max_correction_rad: 0.35,
             degenerate_ratio: Some(0.01),
             max_speed_mps: Some(2.0),
+            recent_speed_factor: 2.0,
             max_turn_rate_rad_s: 3.0,
             allowance: [0.2, 0.2],
             max_failed_travel_m: 2.0,
@@ -121,6 +128,7 @@ impl TrackingGuardConfig {
         if let Some(v) = self.max_speed_mps {
             require_positive("tracking.max_speed_mps", v)?;
         }
+        require_positive("tracking.recent_speed_factor", self.recent_speed_factor)?;
         require_positive("tracking.max_turn_rate_rad_s", self.max_turn_rate_rad_s)?;
         require_positive("tracking.max_failed_travel_m", self.max_failed_travel_m)?;
         for v in self.allowance {
@@ -137,10 +145,17 @@ impl TrackingGuardConfig {
         Ok(())
     }
 
+    /// The speed bound, m/s, given the recent speed (`None`: no speed test).
+    pub fn speed_bound(&self, recent_speed_mps: f64) -> Option<f64> {
+        self.max_speed_mps
+            .map(|v| v.max(self.recent_speed_factor * recent_speed_mps))
+    }
+
     /// Whether the odometry increment `delta` over `dt` seconds is one the robot can have
-    /// driven (always true without a speed bound or a usable `dt`).
-    pub fn plausible(&self, delta: &Pose2, dt: f64) -> bool {
-        let Some(v) = self.max_speed_mps else {
+    /// driven, after driving at `recent_speed_mps` lately (always true without a speed bound
+    /// or a usable `dt`).
+    pub fn plausible(&self, delta: &Pose2, dt: f64, recent_speed_mps: f64) -> bool {
+        let Some(v) = self.speed_bound(recent_speed_mps) else {
             return true;
         };
         if !(dt.is_finite() && dt >= 0.0) {
@@ -149,6 +164,19 @@ impl TrackingGuardConfig {
         delta.translation().norm() <= v * dt + self.allowance[0]
             && delta.theta().abs() <= self.max_turn_rate_rad_s * dt + self.allowance[1]
     }
+}
+
+/// The window of the recent speed ([`TrackingGuardConfig::recent_speed_factor`]), seconds.
+pub const SPEED_WINDOW_S: f64 = 2.0;
+
+/// The recent speed after a plausible increment of `step` metres over `dt` seconds: an
+/// exponential average with the time constant [`SPEED_WINDOW_S`].
+pub(crate) fn update_recent_speed(recent: f64, step: f64, dt: f64) -> f64 {
+    if !(dt.is_finite() && dt > 0.0 && step.is_finite()) {
+        return recent;
+    }
+    let alpha = (dt / SPEED_WINDOW_S).min(1.0);
+    recent + alpha * (step / dt - recent)
 }
 
 /// Counters of the front-end's guards.
@@ -254,11 +282,28 @@ mod tests {
     #[test]
     fn odometry_faster_than_the_robot_is_implausible() {
         let c = TrackingGuardConfig::default();
-        assert!(c.plausible(&Pose2::new(0.1, 0.0, 0.05), 0.1));
-        assert!(!c.plausible(&Pose2::new(1.0, 0.0, 0.0), 0.1));
-        assert!(!c.plausible(&Pose2::new(0.0, 0.0, 20f64.to_radians()), 0.0));
+        assert!(c.plausible(&Pose2::new(0.1, 0.0, 0.05), 0.1, 0.0));
+        assert!(!c.plausible(&Pose2::new(1.0, 0.0, 0.0), 0.1, 0.0));
+        assert!(!c.plausible(&Pose2::new(0.0, 0.0, 20f64.to_radians()), 0.0, 0.0));
         // After a 5 s gap in the log, 2 m is possible.
-        assert!(c.plausible(&Pose2::new(2.0, 0.0, 0.3), 5.0));
+        assert!(c.plausible(&Pose2::new(2.0, 0.0, 0.3), 5.0, 0.0));
+    }
+
+    #[test]
+    fn a_fast_vehicle_raises_the_bound_and_a_jump_stays_implausible() {
+        let c = TrackingGuardConfig::default();
+        // 0.4 m every 0.05 s (8 m/s): implausible from rest, plausible at speed.
+        let step = Pose2::new(0.4, 0.0, 0.0);
+        assert!(!c.plausible(&step, 0.05, 0.0));
+        let mut recent = 0.0;
+        for _ in 0..1000 {
+            recent = update_recent_speed(recent, 0.4, 0.05);
+        }
+        assert!((recent - 8.0).abs() < 1e-3);
+        assert!(c.plausible(&step, 0.05, recent));
+        // A 1 m jump on top of a step is still an outlier.
+        assert!(!c.plausible(&Pose2::new(1.4, 0.0, 0.0), 0.05, recent));
+        assert_eq!(c.speed_bound(recent), Some(2.0 * recent));
     }
 
     #[test]
