@@ -64,21 +64,25 @@ pub fn write_png(out: &SlamOutput, path: &Path) -> Result<()> {
             red[j * w + i] = true;
         }
     }
-    let img = image::RgbImage::from_fn(w as u32, h as u32, |i, j| {
-        let k = j as usize * w + i as usize;
-        if red[k] {
-            return image::Rgb([220, 0, 0]);
-        }
-        let v = sum[k];
-        let g = if v > 1.0 {
-            0
-        } else if v < -0.5 {
-            255
-        } else {
-            200
-        };
-        image::Rgb([g, g, g])
-    });
-    img.save(path)
+    // Four colours in a palette: the pictures stay as small as grey ones.
+    let pixels: Vec<u8> = sum
+        .iter()
+        .zip(&red)
+        .map(|(&v, &r)| match (r, v) {
+            (true, _) => 3,
+            (false, v) if v > 1.0 => 0,
+            (false, v) if v < -0.5 => 1,
+            _ => 2,
+        })
+        .collect();
+    let file =
+        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
+    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), w as u32, h as u32);
+    encoder.set_color(png::ColorType::Indexed);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_palette(vec![0, 0, 0, 255, 255, 255, 200, 200, 200, 220, 0, 0]);
+    encoder
+        .write_header()
+        .and_then(|mut writer| writer.write_image_data(&pixels))
         .with_context(|| format!("writing {}", path.display()))
 }
