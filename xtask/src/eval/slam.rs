@@ -92,7 +92,7 @@ struct Scored {
     /// ([`raypath_slam::benchmark::LoopCheck::reference_disputed`]).
     disputed: usize,
     checked: usize,
-    seconds: f64,
+    seconds: Took,
     scans: usize,
     /// Over the benchmark's own relation file, when the data set has it.
     benchmark: Option<ErrorSummary>,
@@ -138,14 +138,44 @@ fn read(ctx: &EvalContext, path: &str, limit: Option<usize>) -> Result<Vec<Plana
     Ok(frames)
 }
 
-fn run_slam(frames: &[PlanarFrame], config: SlamConfig) -> Result<(SlamOutput, f64)> {
-    let started = Instant::now();
+/// How long a run took: wall-clock seconds and, where the system tells, the CPU seconds of
+/// the thread that ran it (SLAM runs on one thread), which other work on the machine does
+/// not inflate.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Took {
+    pub(super) wall: f64,
+    pub(super) cpu: Option<f64>,
+}
+
+impl Took {
+    fn since(started: Instant, cpu_started: Option<f64>) -> Self {
+        Self {
+            wall: started.elapsed().as_secs_f64(),
+            cpu: thread_cpu_seconds().zip(cpu_started).map(|(b, a)| b - a),
+        }
+    }
+}
+
+/// CPU seconds the calling thread has used (`/proc/thread-self/stat`, Linux, in clock ticks
+/// of 10 ms); `None` where that file does not exist.
+fn thread_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
+    // Fields after the command name (which may hold spaces) start at field 3 (state);
+    // utime and stime are fields 14 and 15.
+    let rest = stat.rsplit_once(')')?.1;
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |k: usize| fields.get(k).and_then(|v| v.parse::<f64>().ok());
+    Some((ticks(11)? + ticks(12)?) / 100.0)
+}
+
+fn run_slam(frames: &[PlanarFrame], config: SlamConfig) -> Result<(SlamOutput, Took)> {
+    let (started, cpu) = (Instant::now(), thread_cpu_seconds());
     let mut slam = Slam::new(config)?;
     for f in frames {
         slam.process(f)?;
     }
     let out = slam.finish()?;
-    Ok((out, started.elapsed().as_secs_f64()))
+    Ok((out, Took::since(started, cpu)))
 }
 
 /// A log's reference and relation sets: they depend on the frames only, so every method run
@@ -207,7 +237,7 @@ fn score(
     frames: &[PlanarFrame],
     poses: &[Pose2],
     out: Option<&SlamOutput>,
-    seconds: f64,
+    seconds: Took,
 ) -> Scored {
     let truth = &rel.truth;
     let consecutive = relation_errors(truth, poses, &rel.consecutive);
@@ -253,8 +283,8 @@ fn score(
 
 /// A scored method on a log as JSON: the keys of the report's rows (`page::table_row`).
 fn row_json(log: &str, method: &str, s: &Scored) -> Value {
-    let sps = if s.seconds > 0.0 {
-        s.scans as f64 / s.seconds
+    let sps = if s.seconds.wall > 0.0 {
+        s.scans as f64 / s.seconds.wall
     } else {
         f64::NAN
     };
@@ -268,7 +298,8 @@ fn row_json(log: &str, method: &str, s: &Scored) -> Value {
         "benchmark_relations": s.benchmark,
         "benchmark_relations_local": s.benchmark_local,
         "benchmark_relations_across_loops": s.benchmark_across,
-        "seconds": s.seconds, "scans": s.scans, "scans_per_second": sps,
+        "seconds": s.seconds.wall, "cpu_seconds": s.seconds.cpu, "scans": s.scans,
+        "scans_per_second": sps,
     })
 }
 
@@ -374,9 +405,9 @@ fn referenced(ctx: &EvalContext, name: &str, raw: &str, corrected: &str) -> Resu
     let mut rows = vec![row_json(
         name,
         "odometry",
-        &score(&relations, &frames, &odometry, None, 0.0),
+        &score(&relations, &frames, &odometry, None, Took::default()),
     )];
-    let started = Instant::now();
+    let (started, cpu) = (Instant::now(), thread_cpu_seconds());
     let matcher = raypath_reflectivity::MatcherConfig {
         map: raypath_reflectivity::MapConfig {
             size_m: 160.0,
@@ -391,7 +422,7 @@ fn referenced(ctx: &EvalContext, name: &str, raw: &str, corrected: &str) -> Resu
         &frames,
         &hector,
         None,
-        started.elapsed().as_secs_f64(),
+        Took::since(started, cpu),
     );
     rows.push(row_json(name, "front-end alone (Hector, one map)", &s));
     let mut map = None;
@@ -430,18 +461,18 @@ fn unreferenced(ctx: &EvalContext, name: &str, raw: &str) -> Result<Value> {
         ..SlamConfig::default()
     };
     let (base, _) = run_slam(&frames, no_loops)?;
-    let (out, seconds) = run_slam(&frames, SlamConfig::default())?;
+    let (out, took) = run_slam(&frames, SlamConfig::default())?;
     let (d0, _) = submap_disagreement(&base);
     let (d, compared) = submap_disagreement(&out);
     let png = format!("{name}.png");
     super::slam_map::write_png(&out, &ctx.figure_dir(NAME)?.join(&png))?;
-    let sps = frames.len() as f64 / seconds;
+    let sps = frames.len() as f64 / took.wall;
     Ok(json!({
         "log": name, "scans": frames.len(), "nodes": out.nodes.len(),
         "submaps": out.submaps.len(),
         "loop_closures": out.loop_closures.len(), "rejected_loop_closures": out.rejected_loop_closures.len(),
         "disagreement_without_loops": d0, "disagreement": d, "cells_compared": compared,
-        "seconds": seconds, "scans_per_second": sps, "map": png,
+        "seconds": took.wall, "cpu_seconds": took.cpu, "scans_per_second": sps, "map": png,
     }))
 }
 
@@ -475,7 +506,7 @@ fn ablation(ctx: &EvalContext, world: &str) -> Result<Value> {
     for &mode in modes {
         let mut config = SlamConfig::default();
         config.matcher.mode = mode;
-        let started = Instant::now();
+        let (started, cpu) = (Instant::now(), thread_cpu_seconds());
         let mut slam = Slam::new(config)?.with_correction(lut.clone());
         for f in &frames {
             slam.process(f)?;
@@ -486,7 +517,7 @@ fn ablation(ctx: &EvalContext, world: &str) -> Result<Value> {
             &frames,
             &out.world_from_sensor,
             Some(&out),
-            started.elapsed().as_secs_f64(),
+            Took::since(started, cpu),
         );
         let mut v = row_json(world, mode.name(), &s);
         if let Some(obj) = v.as_object_mut() {
