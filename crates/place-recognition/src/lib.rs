@@ -205,8 +205,8 @@ pub use shot::{
 // --- evaluation (PR work) ---
 pub use online::{LoopClosure, LoopConfig, LoopDetector, best_candidate, detect_loops};
 pub use pr::{
-    CrossSummary, CrossTruth, Exclusion, GroundTruth, PrCurve, PrPoint, PrSummary, cross_pr,
-    cross_summary, kidnapped_pr, online_pr, recall_at_k,
+    Confidence, CrossSummary, CrossTruth, Exclusion, GroundTruth, PrCurve, PrPoint, PrSummary,
+    cross_pr, cross_summary, kidnapped_pr, online_pr, recall_at_k,
 };
 pub use run::{
     FrameTiming, KidnappedRun, OnlineRun, run_kidnapped, run_kidnapped_serial, run_online,

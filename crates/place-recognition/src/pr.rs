@@ -48,7 +48,7 @@ mod truth;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-pub use cross::{CrossSummary, CrossTruth, cross_pr, cross_summary, recall_at_k};
+pub use cross::{Confidence, CrossSummary, CrossTruth, cross_pr, cross_summary, recall_at_k};
 pub use truth::{Exclusion, GroundTruth};
 
 use crate::online::{LoopConfig, LoopDetector, best_candidate};

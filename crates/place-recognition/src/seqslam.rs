@@ -18,9 +18,8 @@
 //!    noisier and win by chance. The sequence score of `(q, j)` is `−min_v S` (higher = more
 //!    similar), NaN (not proposed) when no line fits.
 //!
-//! Ours: the match confidence is the sequence score itself (the paper also tests the ratio of
-//! the best to the second best score outside a window; [`crate::cross_summary`] sweeps a
-//! threshold over the score instead). Cost per query: `O(N · velocity_steps · d_s)` for `N`
+//! The paper accepts a match by the ratio of the best to the second best sequence score
+//! outside a window: [`crate::Confidence::Margin`] sweeps the threshold over that margin. Cost per query: `O(N · velocity_steps · d_s)` for `N`
 //! database frames, plus `O(N)` for the contrast enhancement of its row.
 
 use rayon::prelude::*;
@@ -205,7 +204,7 @@ pub fn sequence_match_timed(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{CrossTruth, cross_summary};
+    use crate::{Confidence, CrossTruth, cross_summary};
 
     /// splitmix64 in [0, 1).
     fn noise(seed: u64) -> f32 {
@@ -238,7 +237,7 @@ mod tests {
         }
         let scores = ScoreMatrix::from_rows(n, n, rows).expect("n × n");
         let truth = CrossTruth::from_frames((0..n).map(Some).collect(), n, 0);
-        let single = cross_summary(&scores, &truth).expect("single");
+        let single = cross_summary(&scores, &truth, Confidence::Score).expect("single");
         let seq = sequence_match(&scores, &SequenceConfig::default()).expect("seq");
         let (timed, _) = sequence_match_timed(&scores, &SequenceConfig::default()).expect("timed");
         let bits = |m: &ScoreMatrix| -> Vec<u32> {
@@ -247,7 +246,7 @@ mod tests {
                 .collect()
         };
         assert!(bits(&seq) == bits(&timed), "parallel and timed runs differ");
-        let s = cross_summary(&seq, &truth).expect("sequence");
+        let s = cross_summary(&seq, &truth, Confidence::Score).expect("sequence");
         assert!(single.recall_at_1 < 0.8, "{single:?}");
         // Queries 9.. have full sequences; at least 95 % of them find their frame (the noise
         // is random: a rare noise line can still win).

@@ -8,6 +8,10 @@
 //!   best scores, a query is *detected* when its best score is at least the threshold,
 //!   *correct* when its best frame is a true match. Precision = correct / detected, recall =
 //!   correct / queries with a true match in the database. Conventions as in [`crate::PrCurve`].
+//!   The confidence swept is the best score itself ([`Confidence::Score`]) or, as SeqSLAM
+//!   accepts a match (Milford & Wyeth 2012, §III-C), its margin over the best score outside
+//!   a window around the best frame ([`Confidence::Margin`]; ours: the difference, where the
+//!   paper takes the ratio of the two differences — scores may be negative here).
 //! * **Recall@K**: the share of queries with a true match that have one among their `K` best
 //!   frames (no threshold).
 
@@ -15,7 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::cross::ScoreMatrix;
 use crate::pr::{PrCurve, point};
-use crate::{PlaceError, Result};
+use crate::{Candidate, PlaceError, Result};
 
 /// Which database frames are the same place as each query.
 #[derive(Clone, Debug, PartialEq)]
@@ -93,6 +97,42 @@ impl CrossTruth {
     }
 }
 
+/// What the threshold of [`cross_pr`] is swept over.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Confidence {
+    /// The best match's score.
+    #[default]
+    Score,
+    /// The best score minus the best score of the frames more than `window` frames from the
+    /// best one (NaN, never detected, when there is none).
+    Margin {
+        /// Half-width of the excluded window, database frames.
+        window: usize,
+    },
+}
+
+impl Confidence {
+    /// The confidence of query row `row` whose best match is `best`.
+    fn of(self, row: &[f32], best: Candidate) -> f64 {
+        match self {
+            Confidence::Score => best.score,
+            Confidence::Margin { window } => {
+                let runner_up = row
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, s)| j.abs_diff(best.frame) > window && !s.is_nan())
+                    .map(|(_, &s)| f64::from(s))
+                    .fold(f64::NEG_INFINITY, f64::max);
+                if runner_up.is_finite() {
+                    best.score - runner_up
+                } else {
+                    f64::NAN
+                }
+            }
+        }
+    }
+}
+
 /// The criteria of a query-against-database run.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CrossSummary {
@@ -121,15 +161,19 @@ fn check(scores: &ScoreMatrix, truth: &CrossTruth) -> Result<()> {
     Ok(())
 }
 
-/// The precision–recall curve of the best match per query (module documentation).
-pub fn cross_pr(scores: &ScoreMatrix, truth: &CrossTruth) -> Result<PrCurve> {
+/// The precision–recall curve of the best match per query, the threshold swept over
+/// `confidence` (module documentation).
+pub fn cross_pr(
+    scores: &ScoreMatrix,
+    truth: &CrossTruth,
+    confidence: Confidence,
+) -> Result<PrCurve> {
     check(scores, truth)?;
     let mut best: Vec<(f64, bool)> = (0..scores.queries())
         .filter_map(|q| {
             let b = scores.best(q, 1).into_iter().next()?;
-            b.score
-                .is_finite()
-                .then(|| (b.score, truth.is_match(q, b.frame)))
+            let c = confidence.of(scores.row(q), b);
+            c.is_finite().then(|| (c, truth.is_match(q, b.frame)))
         })
         .collect();
     best.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
@@ -159,9 +203,14 @@ pub fn recall_at_k(scores: &ScoreMatrix, truth: &CrossTruth, k: usize) -> Result
     Ok(found as f64 / positives as f64)
 }
 
-/// Recall at 100 % precision, recall@1, recall@5 and max F1 of a run.
-pub fn cross_summary(scores: &ScoreMatrix, truth: &CrossTruth) -> Result<CrossSummary> {
-    let curve = cross_pr(scores, truth)?.summary();
+/// Recall at 100 % precision, recall@1, recall@5 and max F1 of a run (the curve's threshold
+/// swept over `confidence`).
+pub fn cross_summary(
+    scores: &ScoreMatrix,
+    truth: &CrossTruth,
+    confidence: Confidence,
+) -> Result<CrossSummary> {
+    let curve = cross_pr(scores, truth, confidence)?.summary();
     Ok(CrossSummary {
         recall_at_100_precision: curve.recall_at_100_precision,
         recall_at_1: recall_at_k(scores, truth, 1)?,
@@ -206,13 +255,29 @@ mod tests {
         ];
         let scores = ScoreMatrix::from_rows(3, 4, rows).expect("3 × 4");
         let truth = CrossTruth::from_frames(vec![Some(0), Some(1), Some(2)], 4, 0);
-        let s = cross_summary(&scores, &truth).expect("summary");
+        let s = cross_summary(&scores, &truth, Confidence::Score).expect("summary");
         assert!((s.recall_at_100_precision - 1.0 / 3.0).abs() < 1e-12);
         assert!((s.recall_at_1 - 2.0 / 3.0).abs() < 1e-12);
         assert_eq!(s.recall_at_5, 1.0);
         // Max F1 at the lowest threshold: P = R = 2/3.
         assert!((s.max_f1 - 2.0 / 3.0).abs() < 1e-12);
         let wrong = CrossTruth::from_frames(vec![Some(0)], 4, 0);
-        assert!(cross_summary(&scores, &wrong).is_err());
+        assert!(cross_summary(&scores, &wrong, Confidence::Score).is_err());
+    }
+
+    #[test]
+    fn margin_ranks_distinct_matches_first() {
+        // q0: best 0.9 at frame 0, runner-up outside ±1 is 0.85 (margin 0.05, wrong match);
+        // q1: best 0.5 at frame 1 (correct), runner-up outside ±1 is 0.1 (margin 0.4). By score
+        // the wrong match comes first (recall at 100 % precision 0); by margin the right one.
+        let rows = vec![0.9, 0.0, 0.85, 0.0, 0.1, 0.5, 0.4, 0.0];
+        let scores = ScoreMatrix::from_rows(2, 4, rows).expect("2 × 4");
+        let truth = CrossTruth::from_frames(vec![Some(3), Some(1)], 4, 0);
+        let by_score = cross_summary(&scores, &truth, Confidence::Score).expect("score");
+        let by_margin =
+            cross_summary(&scores, &truth, Confidence::Margin { window: 1 }).expect("margin");
+        assert_eq!(by_score.recall_at_100_precision, 0.0);
+        assert_eq!(by_margin.recall_at_100_precision, 0.5);
+        assert_eq!(by_score.recall_at_1, by_margin.recall_at_1);
     }
 }
