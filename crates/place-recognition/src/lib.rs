@@ -216,7 +216,7 @@ pub use run::{
 
 // --- query against database (Nordland work) ---
 pub use cross::{CrossRun, ScoreMatrix, run_cross};
-pub use raw_pixels::{RawPixelConfig, RawPixels, mean_abs_difference, patch_normalise};
+pub use raw_pixels::{RawPixelConfig, RawPixels, mean_abs_difference, patch_normalise, quantise};
 pub use seqslam::{
     SequenceConfig, difference_row, enhance_row, enhanced_differences, sequence_match,
     sequence_match_timed, sequence_row,
