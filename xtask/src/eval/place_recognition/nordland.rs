@@ -358,45 +358,57 @@ pub fn run(ctx: &EvalContext) -> Result<Section> {
     let mut rows = direction(&summer, &winter)?;
     rows.extend(direction(&winter, &summer)?);
     let speed = super::nordland_speed::run(&summer, &winter)?;
-    let mut md = String::new();
-    writeln!(
-        md,
-        "**Real** camera frames: the Nordland ride in summer and in winter ({} frames each{}, \
-         64 × 32 px grey; the same file name is the same place). One season is the database, \
-         the other the queries; a query's best match is correct within ±{TOLERANCE} frames. \
-         R@100P = recall at 100 % precision over the best match per query, the threshold swept \
-         over its score, or over its margin above the best score more than {MARGIN_WINDOW} \
-         frames away (SeqSLAM's uniqueness test, as a difference); R@1 / R@5 = a correct frame among the 1 / 5 best (no threshold), \
-         max F1 over the same sweep; ms/query = describe + score against the whole database, \
-         one thread (with sequence matching: plus its difference-matrix row, contrast \
-         enhancement and line search). Sequence rows: SeqSLAM (Milford & Wyeth 2012) on the \
-         method's own scores, the last {SEQUENCE} queries, velocities 0.8–1.25, contrast window \
-         10. IBuILD, symmetric IBuILD and DBoW2-style see the frames enlarged {UPSCALE}× \
-         (bilinear, 256 × 128 px): at 64 × 32 px the 31-pixel descriptor patch fits only in a \
-         34 × 2 px band. DBoW2-style's vocabulary is trained on the database season (seeded; \
-         the queries are never seen). Khan's Table 4.2 figures stand beside IBuILD and \
-         DBoW2-style for reference only: other data (not like for like). GIST runs at 64 × 64 \
-         px with a 16-pixel mirror border (the reference 128 px would only interpolate these \
-         64-px-wide frames); HOG and raw pixels at their defaults. A random guess has R@1 = \
-         {} % ({} correct frames of {}).\n",
-        summer.images.len(),
-        if ctx.quick {
-            ", quick run: the first ones"
-        } else {
-            ""
-        },
-        fmt_num(
-            100.0 * (2 * TOLERANCE + 1) as f64 / summer.images.len() as f64,
-            2
-        ),
-        2 * TOLERANCE + 1,
-        summer.images.len(),
-    )?;
+    let mut md = intro(ctx.quick, summer.images.len())?;
     md.push_str(&table(&rows)?);
     md.push('\n');
     md.push_str(&known);
     md.push('\n');
     md.push_str(&speed.markdown);
+    Ok(Section {
+        markdown: md,
+        json: json!({ "rows": rows, "speed": speed.json }),
+        summary: summary_lines(&rows),
+    })
+}
+
+/// The text above the table: data, protocol, criteria and settings.
+fn intro(quick: bool, frames: usize) -> Result<String> {
+    let mut md = String::new();
+    writeln!(
+        md,
+        "**Real** camera frames: the Nordland ride in summer and in winter ({frames} frames \
+         each{}, 64 × 32 px grey; the same file name is the same place). One season is the \
+         database, the other the queries; a query's best match is correct within \
+         ±{TOLERANCE} frames. R@100P = recall at 100 % precision over the best match per \
+         query, the threshold swept over its score, or over its margin above the best score \
+         more than {MARGIN_WINDOW} frames away (SeqSLAM's uniqueness test, as a difference); \
+         R@1 / R@5 = a correct frame among the 1 / 5 best (no threshold), max F1 over the same \
+         sweep; ms/query = describe + score against the whole database, one thread (with \
+         sequence matching: plus its difference-matrix row, contrast enhancement and line \
+         search). Sequence rows: SeqSLAM (Milford & Wyeth 2012) on the method's own scores, \
+         the last {SEQUENCE} queries, velocities 0.8–1.25, contrast window 10. IBuILD, \
+         symmetric IBuILD and DBoW2-style see the frames enlarged {UPSCALE}× (bilinear, \
+         256 × 128 px): at 64 × 32 px the 31-pixel descriptor patch fits only in a 34 × 2 px \
+         band. DBoW2-style's vocabulary is trained on the database season (seeded; the \
+         queries are never seen). Khan's Table 4.2 figures stand beside IBuILD and \
+         DBoW2-style for reference only: other data (not like for like). GIST runs at 64 × 64 \
+         px with a 16-pixel mirror border (the reference 128 px would only interpolate these \
+         64-px-wide frames); HOG and raw pixels at their defaults. A random guess has R@1 = \
+         {} % ({} correct frames of {frames}).\n",
+        if quick {
+            ", quick run: the first ones"
+        } else {
+            ""
+        },
+        fmt_num(100.0 * (2 * TOLERANCE + 1) as f64 / frames as f64, 2),
+        2 * TOLERANCE + 1,
+    )?;
+    Ok(md)
+}
+
+/// The section's lines of the page summary: the best rows, and IBuILD against DBoW2-style
+/// in each direction.
+fn summary_lines(rows: &[Row]) -> Vec<String> {
     let best = |seq: bool| {
         rows.iter()
             .filter(|r| r.sequence.is_some() == seq)
@@ -415,39 +427,34 @@ pub fn run(ctx: &EvalContext) -> Result<Section> {
             seq.direction
         ));
     }
-    let directions: Vec<String> = rows
-        .first()
-        .into_iter()
-        .chain(rows.last())
-        .map(|r| r.direction.clone())
-        .collect();
-    for dir in &directions {
-        let find = |m: &str| {
-            rows.iter()
-                .find(|r| &r.direction == dir && r.method == m && r.sequence.is_none())
-                .map(|r| r.summary)
-        };
-        if let (Some(ib), Some(db)) = (find("IBuILD"), find("DBoW2-style")) {
-            summary.push(format!(
-                "Nordland {dir}: IBuILD R@100P {:.2} %, R@1 {:.1} % vs DBoW2-style R@100P \
-                 {:.2} %, R@1 {:.1} % ({})",
-                100.0 * ib.recall_at_100_precision,
-                100.0 * ib.recall_at_1,
-                100.0 * db.recall_at_100_precision,
-                100.0 * db.recall_at_1,
-                if ib.recall_at_100_precision == 0.0 && db.recall_at_100_precision == 0.0 {
-                    "a tie at 0 at 100 % precision"
-                } else if ib.recall_at_100_precision >= db.recall_at_100_precision {
-                    "IBuILD ≥ DBoW2-style at 100 % precision"
-                } else {
-                    "IBuILD below DBoW2-style at 100 % precision"
-                }
-            ));
-        }
-    }
-    Ok(Section {
-        markdown: md,
-        json: json!({ "rows": rows, "speed": speed.json }),
-        summary,
-    })
+    let mut directions: Vec<&str> = rows.iter().map(|r| r.direction.as_str()).collect();
+    directions.dedup();
+    summary.extend(directions.into_iter().filter_map(|d| ibuild_line(rows, d)));
+    summary
+}
+
+/// IBuILD against DBoW2-style (single image) in one direction.
+fn ibuild_line(rows: &[Row], direction: &str) -> Option<String> {
+    let find = |m: &str| {
+        rows.iter()
+            .find(|r| r.direction == direction && r.method == m && r.sequence.is_none())
+            .map(|r| r.summary)
+    };
+    let (ib, db) = (find("IBuILD")?, find("DBoW2-style")?);
+    let (a, b) = (ib.recall_at_100_precision, db.recall_at_100_precision);
+    let verdict = if a == 0.0 && b == 0.0 {
+        "a tie at 0 at 100 % precision"
+    } else if a >= b {
+        "IBuILD ≥ DBoW2-style at 100 % precision"
+    } else {
+        "IBuILD below DBoW2-style at 100 % precision"
+    };
+    Some(format!(
+        "Nordland {direction}: IBuILD R@100P {:.2} %, R@1 {:.1} % vs DBoW2-style R@100P {:.2} \
+         %, R@1 {:.1} % ({verdict})",
+        100.0 * a,
+        100.0 * ib.recall_at_1,
+        100.0 * b,
+        100.0 * db.recall_at_1,
+    ))
 }
