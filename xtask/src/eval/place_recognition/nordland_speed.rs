@@ -1,7 +1,7 @@
 //! Section 6's speed table: every Nordland method timed against a database of more than
 //! 10 000 **real** frames — summer, summer mirrored left–right and winter mirrored (10 728
 //! frames; a quick run: three times its first frames) — with the first winter frames as
-//! queries (none of them is in the database), on one thread. The aim of issue 36: at most
+//! queries (none of them is in the database), on one thread. The aim: at most
 //! 5 ms per query at 10 000 frames.
 
 use std::fmt::Write;
