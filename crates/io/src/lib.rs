@@ -14,6 +14,8 @@
 //!   installation (own CDR decoder; the message types and what is ignored are listed there);
 //!   [`foxglove`] writes results as an MCAP that Foxglove opens with no plugin; [`convert`]
 //!   turns CARMEN logs, KITTI sequences and PCD files into bags and back.
+//! * **Images.** [`images`] lists the PNG/JPEG files of a folder in name order and decodes
+//!   them as 8-bit grey, one at a time (camera place recognition).
 //! * **Ouster.** [`ouster`] decodes Ouster lidar packets from pcap/pcapng captures with the
 //!   sensor's metadata JSON into organized range images and point clouds with reflectivity.
 //!
@@ -60,6 +62,7 @@ pub mod carmen;
 pub mod convert;
 pub mod data;
 pub mod foxglove;
+pub mod images;
 pub mod kitti;
 pub mod lzw;
 pub mod nclt;

@@ -70,6 +70,11 @@ pub trait PlaceRecognizer {
     /// Number of frames in the database.
     fn len(&self) -> usize;
 
+    /// A new sequence of frames starts (a query sequence after the database,
+    /// [`crate::run_cross`]): methods that look at consecutive frames forget the previous one.
+    /// Default: nothing to forget.
+    fn start_sequence(&mut self) {}
+
     /// True when the database is empty.
     fn is_empty(&self) -> bool {
         self.len() == 0

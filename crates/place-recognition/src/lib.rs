@@ -16,6 +16,12 @@
 //! | [`Shot3dBow`] (`shot`, `shot-intensity`) | clouds | SHOT / intensity-textured SHOT on a voxel grid, words merged by averaging, tf–idf similarity eqs. (4.2)–(4.3) | Khan §4.5.2 |
 //! | [`ScanContext`] | clouds | max height per ring × sector, ring key in a k-d tree, column-shift cosine distance | Kim & Kim, IROS 2018 (from the paper) |
 //! | [`PolarContext`] | planar scans | the same idea for 2-D scans (end-point counts per ring × sector) | ours |
+//! | [`RawPixels`] | same as the images | downsampled, patch-normalised pixels, mean absolute difference (SeqSLAM's single-image comparison) | Milford & Wyeth 2012 |
+//!
+//! Any method's scores of a query sequence against a database sequence ([`run_cross`], a
+//! [`ScoreMatrix`]) can feed **sequence matching** ([`sequence_match`], SeqSLAM: difference
+//! matrix, local contrast enhancement, straight-line search over `d_s` frames), scored by
+//! [`cross_summary`] against a [`CrossTruth`] (same file name ± a frame tolerance).
 //!
 //! Images of lidar data come from [`frame_image`]: planar scans are rasterised
 //! ([`rasterize_scan`]), clouds are projected to equirectangular **intensity** or **range**
@@ -143,6 +149,12 @@ mod online;
 mod pr;
 mod run;
 
+// Query sequence against a database sequence (Nordland), the raw-pixel baseline and
+// sequence matching (SeqSLAM, Milford & Wyeth 2012).
+mod cross;
+mod raw_pixels;
+mod seqslam;
+
 pub use binary::{BinaryDescriptor, Bits256, Bits512};
 pub use error::{PlaceError, Result};
 pub use frame::{Candidate, Frame, OwnedFrame, PlaceRecognizer};
@@ -192,9 +204,21 @@ pub use shot::{
 
 // --- evaluation (PR work) ---
 pub use online::{LoopClosure, LoopConfig, LoopDetector, best_candidate, detect_loops};
-pub use pr::{Exclusion, GroundTruth, PrCurve, PrPoint, PrSummary, kidnapped_pr, online_pr};
+pub use pr::{
+    Confidence, CrossSummary, CrossTruth, Exclusion, GroundTruth, PrCurve, PrPoint, PrSummary,
+    cross_pr, cross_summary, kidnapped_pr, online_pr, recall_at_k,
+};
 pub use run::{
     FrameTiming, KidnappedRun, OnlineRun, run_kidnapped, run_kidnapped_serial, run_online,
     sort_candidates,
 };
 // --- end evaluation ---
+
+// --- query against database (Nordland work) ---
+pub use cross::{CrossRun, ScoreMatrix, run_cross};
+pub use raw_pixels::{RawPixelConfig, RawPixels, mean_abs_difference, patch_normalise, quantise};
+pub use seqslam::{
+    SequenceConfig, difference_row, enhance_row, enhanced_differences, sequence_match,
+    sequence_match_timed, sequence_row,
+};
+// --- end query against database ---

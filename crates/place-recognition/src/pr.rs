@@ -42,11 +42,13 @@
 //! reached (the maximum over an empty set of precisions, taken as their lower bound). Scores
 //! that are not finite are ignored (never detected).
 
+mod cross;
 mod truth;
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+pub use cross::{Confidence, CrossSummary, CrossTruth, cross_pr, cross_summary, recall_at_k};
 pub use truth::{Exclusion, GroundTruth};
 
 use crate::online::{LoopConfig, LoopDetector, best_candidate};
@@ -109,7 +111,7 @@ impl PrCurve {
 }
 
 /// Precision and recall from counts, with the conventions of the module documentation.
-fn point(threshold: f64, correct: usize, detected: usize, positives: usize) -> PrPoint {
+pub(crate) fn point(threshold: f64, correct: usize, detected: usize, positives: usize) -> PrPoint {
     PrPoint {
         threshold,
         precision: if detected == 0 {

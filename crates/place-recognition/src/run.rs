@@ -35,7 +35,8 @@ pub struct FrameTiming {
 }
 
 impl FrameTiming {
-    fn new(describe_s: f64, query_s: f64, insert_s: f64) -> Self {
+    /// A timing from its three stages (the total is their sum).
+    pub(crate) fn new(describe_s: f64, query_s: f64, insert_s: f64) -> Self {
         Self {
             describe_s,
             query_s,

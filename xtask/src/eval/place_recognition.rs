@@ -18,7 +18,7 @@
 //! * Khan Table 4.2 quoted (camera data sets not available: not comparable).
 //!
 //! `--quick` (CI): Intel and freiburg-079 (every 16th scan), the 40 real KITTI frames, one short
-//! semi-synthetic stretch of sequence 00, speed at 1 000 frames. `PLACE_RECOGNITION_SECTIONS=1,4`
+//! semi-synthetic stretch of sequence 00, speed at 1 000 frames, the first 600 Nordland frames. `PLACE_RECOGNITION_SECTIONS=1,4`
 //! runs only the listed sections; `PLACE_RECOGNITION_STRIDE` sets the frame stride of the full
 //! semi-synthetic drives (default 10).
 //!
@@ -27,7 +27,10 @@
 //! trains it once), one for section 2 (`real-3d`: one database of all real frames), one for the
 //! note on simulated scans under section 3's heading (`simulation-gap`, measured whichever
 //! sections run), one per sequence of section 3 (`semi-kitti/00` …) and one for section 4
-//! (`speed`); the page ([`page`]) from their results alone, section 5 (quoted) in the report
+//! (`speed`), one for section 6 (`nordland`: run it alone with
+//! `PLACE_RECOGNITION_SECTIONS=6 RAYPATH_EVAL_OUT=/tmp/out cargo xtask eval place-recognition`,
+//! which writes its page under `/tmp/out` and leaves `docs/results` alone); the page ([`page`])
+//! from their results alone, section 5 (quoted) in the report
 //! stage. The folds and sequences hand over the cells of their table rows, pictures and JSON;
 //! the single units of sections 2 and 4 hand over their section's text and JSON. A unit of a section left out by `PLACE_RECOGNITION_SECTIONS` measures nothing and
 //! says so; its section reads "Skipped". The 3-D vocabulary ([`methods::kitti_vocabulary`],
@@ -41,6 +44,8 @@ mod camera;
 mod data2d;
 mod kitti_real;
 mod methods;
+mod nordland;
+mod nordland_speed;
 mod page;
 mod plot;
 mod real2d;
@@ -103,6 +108,8 @@ enum UnitResult {
     },
     /// Section 4.
     Speed(Section),
+    /// Section 6 (Nordland).
+    Nordland(Section),
     /// The note on how far simulated scans are from real ones (under section 3's heading,
     /// measured whichever sections run).
     SimulationGap(String),
@@ -121,6 +128,7 @@ fn units(ctx: &EvalContext) -> Result<Vec<String>> {
             .map(|s| format!("semi-kitti/{s}")),
     );
     units.push("speed".into());
+    units.push("nordland".into());
     Ok(units)
 }
 
@@ -135,6 +143,7 @@ fn section_of(unit: &str) -> Result<Option<&'static str>> {
         Some("real-3d") => "2",
         Some("semi-kitti") => "3",
         Some("speed") => "4",
+        Some("nordland") => "6",
         Some(SIMULATION_GAP) => return Ok(None),
         _ => bail!("no unit {unit:?} in {NAME}"),
     }))
@@ -167,6 +176,8 @@ fn run_unit(ctx: &EvalContext, unit: &str) -> Result<Value> {
             sequence: semi_kitti::run_sequence(ctx, sequence, vocabulary.as_ref())?,
             vocabulary_note,
         }
+    } else if unit == "nordland" {
+        UnitResult::Nordland(nordland::run(ctx)?)
     } else {
         UnitResult::Speed(speed::run(ctx)?)
     };

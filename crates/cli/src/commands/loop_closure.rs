@@ -3,10 +3,16 @@
 //! `--laser`, front by default), a KITTI sequence or NCLT session directory (velodyne scans), a
 //! rosbag2 bag (LaserScan or PointCloud2; its directory with `metadata.yaml` or its `.mcap`
 //! file) — these read through `raypath_io::sequence` — or a folder of PNG/JPEG images (sorted
-//! by file name), with the methods of `raypath_place_recognition`: `ibuild` (default), `dbow`,
-//! `scan-context`, `hog`, `gist`, `shot`, `polar`. Methods that cannot describe the input's
-//! frames (Scan Context and SHOT need point clouds, the polar descriptor planar scans) fail
-//! with exit code 2.
+//! by file name, read by `raypath_io::images`), with the methods of
+//! `raypath_place_recognition`: `ibuild` (default), `dbow`, `scan-context`, `hog`, `gist`,
+//! `shot`, `polar`, `raw-pixels`. Methods that cannot describe the input's frames (Scan
+//! Context and SHOT need point clouds, the polar descriptor planar scans) fail with exit code
+//! 2. Images smaller than 128 px on their shorter side are enlarged for the feature stages of
+//! `ibuild` and `dbow` (`--upscale`).
+//!
+//! `--database DIR`: the input folder's images are queries against the database folder's
+//! images, ground truth by file name ± `--tolerance` frames, optional sequence matching
+//! `--sequence D_S` (SeqSLAM) — see `cross`; the modes below do not apply.
 //!
 //! Modes:
 //! - `online` (default): frame by frame, each frame queries the frames at least
@@ -43,6 +49,7 @@
 //! frames have no times), the poses as `/trajectory`, and the accepted loop closures as a
 //! line list between the matched frames' positions on `/loops`.
 
+mod cross;
 mod input;
 mod truth;
 
@@ -53,10 +60,10 @@ use raypath_geometry::Pose3;
 use raypath_io::foxglove::{frame, topic};
 use raypath_place_recognition::{
     BinaryVocabulary, Candidate, Dbow, DbowConfig, Exclusion, FrameTiming, GlobalDescriptorDb,
-    GroundTruth, Ibuild, IbuildConfig, IbuildScore, KidnappedRun, LoopClosure, LoopConfig,
-    PlaceError, PlaceRecognizer, PolarContext, PrSummary, ScanContext, Shot3dBow, VocabularyConfig,
-    detect_and_describe, detect_loops, frame_image, kidnapped_pr, online_pr, run_kidnapped,
-    run_online,
+    GroundTruth, Ibuild, IbuildConfig, IbuildScore, ImageConfig, KidnappedRun, LoopClosure,
+    LoopConfig, OwnedFrame, PlaceError, PlaceRecognizer, PolarContext, PrSummary, RawPixelConfig,
+    RawPixels, ScanContext, Shot3dBow, VocabularyConfig, detect_and_describe, detect_loops,
+    frame_image, kidnapped_pr, online_pr, run_kidnapped, run_online,
 };
 use serde_json::json;
 
@@ -83,6 +90,9 @@ pub enum Method {
     Shot,
     /// Polar descriptor of planar scans.
     Polar,
+    /// Raw pixels: downsampled, patch-normalised, mean absolute difference (SeqSLAM's
+    /// single-image comparison).
+    RawPixels,
 }
 
 /// Evaluation settings.
@@ -158,6 +168,22 @@ pub struct Args {
     /// Kidnapped mode: keep this many best candidates per query (default all).
     #[arg(long, value_name = "K")]
     pub top_k: Option<usize>,
+    /// Database folder of images: the input folder's images are the queries, scored against
+    /// these (same file name = same place); see `cross`.
+    #[arg(long, value_name = "DIR")]
+    pub database: Option<PathBuf>,
+    /// With --database: a query matches the database frames within N frames of the frame
+    /// with its file name.
+    #[arg(long, default_value_t = 2, value_name = "N")]
+    pub tolerance: usize,
+    /// With --database: sequence matching (SeqSLAM) over the last D_S queries on the
+    /// method's scores.
+    #[arg(long, value_name = "D_S")]
+    pub sequence: Option<usize>,
+    /// Enlarge images K times before the feature stages of ibuild and dbow (default: the
+    /// smallest K that gives images a shorter side of at least 128 px; 1 for larger images).
+    #[arg(long, value_name = "K")]
+    pub upscale: Option<u32>,
     /// How to read the input and the ground truth.
     #[command(flatten)]
     pub source: SourceArgs,
@@ -207,12 +233,21 @@ fn check_args(args: &Args) -> Result<(), Failure> {
     if args.delta.is_some() && args.method != Method::Ibuild {
         return bad("--delta applies to --method ibuild only");
     }
+    if args.upscale == Some(0) {
+        return bad("--upscale: must be at least 1");
+    }
+    if args.database.is_none() && args.sequence.is_some() {
+        return bad("--sequence applies with --database only");
+    }
     Ok(())
 }
 
 /// Runs `raypath loop-closure`.
 pub fn run(args: &Args) -> Result<(), Failure> {
     check_args(args)?;
+    if args.database.is_some() {
+        return cross::run(args);
+    }
     let mut recording = Recording::open(&args.record)?;
     let input = read_input(&args.input, &args.source, args.max_frames)?;
     let truth = match &args.ground_truth {
@@ -231,7 +266,14 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             Some((path, ground_truth(path, &args.source, &input, &params)?))
         }
     };
-    let outcome = dispatch(args, &input)?;
+    let outcome = dispatch(
+        args,
+        &input,
+        Execute {
+            args,
+            input: &input,
+        },
+    )?;
     let config = loop_config(args);
     let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()));
     let loops = detect_loops(&config, &outcome.candidates).map_err(place)?;
@@ -321,8 +363,44 @@ pub enum IbuildScoreArg {
     Symmetric,
 }
 
-/// Builds the recognizer and runs it.
-fn dispatch(args: &Args, input: &Input) -> Result<Outcome, Failure> {
+/// What to do with the recognizer `--method` names.
+trait WithRecognizer {
+    /// The result.
+    type Output;
+    /// Runs the recognizer.
+    fn run<R: PlaceRecognizer + Sync>(self, recognizer: R) -> Result<Self::Output, Failure>;
+}
+
+/// The image configuration of the feature methods: `--upscale`, else enlarged to a shorter
+/// side of at least 128 px (images only; other frames as they are).
+fn feature_images(args: &Args, input: &Input) -> Result<ImageConfig, Failure> {
+    let upscale = match args.upscale {
+        Some(k) => k,
+        None if matches!(input.source, input::Source::Images(_)) && !input.labels.is_empty() => {
+            let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()));
+            let first = input.frame(0).map_err(place)?;
+            match first {
+                OwnedFrame::Image(image) => {
+                    ImageConfig::upscale_for(image.width(), image.height(), 128)
+                }
+                _ => 1,
+            }
+        }
+        None => 1,
+    };
+    Ok(ImageConfig {
+        upscale,
+        ..ImageConfig::default()
+    })
+}
+
+/// Builds the recognizer `--method` names and hands it to `with`; `vocabulary_input` trains
+/// DBoW's vocabulary when `--vocabulary` is absent.
+fn dispatch<W: WithRecognizer>(
+    args: &Args,
+    vocabulary_input: &Input,
+    with: W,
+) -> Result<W::Output, Failure> {
     let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()));
     match args.method {
         Method::Ibuild => {
@@ -333,41 +411,42 @@ fn dispatch(args: &Args, input: &Input) -> Result<Outcome, Failure> {
                     IbuildScoreArg::Printed => IbuildScore::Printed,
                     IbuildScoreArg::Symmetric => IbuildScore::Symmetric,
                 },
+                image: feature_images(args, vocabulary_input)?,
                 ..IbuildConfig::default()
             };
-            let r = Ibuild::new(config).map_err(place)?;
-            execute(r, args, input)
+            with.run(Ibuild::new(config).map_err(place)?)
         }
         Method::Dbow => {
-            let config = DbowConfig::default();
-            let vocabulary = dbow_vocabulary(args, input, &config)?;
-            execute(Dbow::new(vocabulary, config), args, input)
+            let config = DbowConfig {
+                image: feature_images(args, vocabulary_input)?,
+                ..DbowConfig::default()
+            };
+            let vocabulary = dbow_vocabulary(args, vocabulary_input, &config)?;
+            with.run(Dbow::new(vocabulary, config))
         }
-        Method::ScanContext => execute(
-            ScanContext::new(Default::default()).map_err(place)?,
-            args,
-            input,
-        ),
-        Method::Hog => execute(
-            GlobalDescriptorDb::hog(Default::default(), Default::default()),
-            args,
-            input,
-        ),
-        Method::Gist => execute(
-            GlobalDescriptorDb::gist(Default::default(), Default::default()).map_err(place)?,
-            args,
-            input,
-        ),
-        Method::Shot => execute(
-            Shot3dBow::new(Default::default()).map_err(place)?,
-            args,
-            input,
-        ),
-        Method::Polar => execute(
-            PolarContext::new(Default::default()).map_err(place)?,
-            args,
-            input,
-        ),
+        Method::ScanContext => with.run(ScanContext::new(Default::default()).map_err(place)?),
+        Method::Hog => with.run(GlobalDescriptorDb::hog(
+            Default::default(),
+            Default::default(),
+        )),
+        Method::Gist => with
+            .run(GlobalDescriptorDb::gist(Default::default(), Default::default()).map_err(place)?),
+        Method::Shot => with.run(Shot3dBow::new(Default::default()).map_err(place)?),
+        Method::Polar => with.run(PolarContext::new(Default::default()).map_err(place)?),
+        Method::RawPixels => with.run(RawPixels::new(RawPixelConfig::default()).map_err(place)?),
+    }
+}
+
+/// Runs the recognizer in the mode of `--mode` on the input.
+struct Execute<'a> {
+    args: &'a Args,
+    input: &'a Input,
+}
+
+impl WithRecognizer for Execute<'_> {
+    type Output = Outcome;
+    fn run<R: PlaceRecognizer + Sync>(self, recognizer: R) -> Result<Outcome, Failure> {
+        execute(recognizer, self.args, self.input)
     }
 }
 
@@ -436,11 +515,18 @@ fn dbow_vocabulary(
                 .map_err(|e| Failure::input(format!("{}: {e}", path.display())))?
         }
         None => {
-            super::console::warn(
-                "no --vocabulary: training the DBoW vocabulary on the input itself; this is \
-                 not the offline protocol (a vocabulary from independent images) and flatters \
-                 DBoW",
-            );
+            if args.database.is_some() {
+                super::console::warn(
+                    "no --vocabulary: training the DBoW vocabulary on the database images (the \
+                     queries are not used); the offline protocol trains it on independent images",
+                );
+            } else {
+                super::console::warn(
+                    "no --vocabulary: training the DBoW vocabulary on the input itself; this is \
+                     not the offline protocol (a vocabulary from independent images) and \
+                     flatters DBoW",
+                );
+            }
             let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()));
             let mut images = Vec::with_capacity(input.len());
             for i in 0..input.len() {

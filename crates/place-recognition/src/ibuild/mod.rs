@@ -248,4 +248,8 @@ impl PlaceRecognizer for Ibuild {
     fn len(&self) -> usize {
         self.vocabulary.num_images()
     }
+
+    fn start_sequence(&mut self) {
+        self.reset_tracking();
+    }
 }

@@ -18,6 +18,7 @@ struct Sections {
     real_3d: Section,
     semi_kitti: Section,
     speed: Section,
+    nordland: Section,
     vocabulary_note: String,
     /// How far simulated scans are from real ones (under section 3's heading).
     simulation_gap: String,
@@ -36,6 +37,7 @@ fn skipped() -> Section {
 fn sections(quick: bool, units: Vec<UnitResult>) -> Result<Sections> {
     let (mut folds, mut sequences) = (Vec::new(), Vec::new());
     let (mut real_3d, mut speed, mut simulation_gap) = (None, None, None);
+    let mut nordland = None;
     let mut notes = Vec::new();
     for unit in units {
         match unit {
@@ -56,6 +58,7 @@ fn sections(quick: bool, units: Vec<UnitResult>) -> Result<Sections> {
                 notes.push(vocabulary_note);
             }
             UnitResult::Speed(section) => speed = Some(section),
+            UnitResult::Nordland(section) => nordland = Some(section),
             UnitResult::SimulationGap(note) => simulation_gap = Some(note),
         }
     }
@@ -72,6 +75,7 @@ fn sections(quick: bool, units: Vec<UnitResult>) -> Result<Sections> {
             semi_kitti::section(quick, &sequences)?
         },
         speed: speed.unwrap_or_else(skipped),
+        nordland: nordland.unwrap_or_else(skipped),
         vocabulary_note: notes
             .into_iter()
             .find(|n| !n.is_empty())
@@ -85,7 +89,7 @@ pub(super) fn report(ctx: &EvalContext, units: Vec<UnitResult>) -> Result<EvalRe
     let s = sections(ctx.quick, units)?;
     let mut md = String::new();
     write_intro(&mut md, ctx.quick)?;
-    let summary: Vec<String> = [&s.real_2d, &s.real_3d, &s.semi_kitti, &s.speed]
+    let summary: Vec<String> = [&s.real_2d, &s.real_3d, &s.nordland, &s.semi_kitti, &s.speed]
         .iter()
         .flat_map(|s| s.summary.iter().cloned())
         .collect();
@@ -111,6 +115,8 @@ pub(super) fn report(ctx: &EvalContext, units: Vec<UnitResult>) -> Result<EvalRe
     md.push_str(&s.speed.markdown);
     writeln!(md, "## 5. Khan Table 4.2 (camera data sets)\n")?;
     let thesis = thesis_table(&mut md)?;
+    writeln!(md, "## 6. Real camera seasons (Nordland)\n")?;
+    md.push_str(&s.nordland.markdown);
     Ok(EvalReport {
         name: NAME,
         title: TITLE.into(),
@@ -123,6 +129,7 @@ pub(super) fn report(ctx: &EvalContext, units: Vec<UnitResult>) -> Result<EvalRe
             "vocabulary_3d": s.vocabulary_note,
             "speed": s.speed.json,
             "thesis_table_4_2": thesis,
+            "nordland": s.nordland.json,
             "summary": summary,
         }),
     })
@@ -149,7 +156,7 @@ fn write_intro(md: &mut String, quick: bool) -> Result<()> {
 /// The headline: the real sections first (3-D, then 2-D), then speed; the semi-synthetic lines
 /// stay on the page.
 fn headline(s: &Sections) -> Option<String> {
-    let lines: Vec<&String> = [&s.real_3d, &s.real_2d, &s.speed]
+    let lines: Vec<&String> = [&s.nordland, &s.real_3d, &s.real_2d, &s.speed]
         .iter()
         .flat_map(|s| s.summary.iter())
         .collect();
@@ -199,7 +206,9 @@ fn thesis_table(md: &mut String) -> Result<Value> {
         "Khan 2017, Table 4.2 (maximum recall at 100 % precision, the Gálvez-López evaluation \
          script and hand-made loop intervals). The camera data sets (Malaga 2009 parking 6L, \
          Oxford City Centre) are **not available here**, so our numbers above (other data, \
-         other ground truth) cannot be set beside these: not comparable.\n\n{}",
+         other ground truth) cannot be set beside these: not comparable. The real camera rows \
+         of section 6 (Nordland, other data) carry these figures beside IBuILD and DBoW2-style, \
+         also not like for like.\n\n{}",
         t.to_markdown()?
     )?;
     Ok(json!(
@@ -281,7 +290,8 @@ mod tests {
 
     /// The units of a full run in which section 4 is left out, `freiburg-079` and
     /// `kitti-poles/02` are missing: logs in the order of `LOGS` across the folds, the notes,
-    /// the skipped section, the summary, headline and JSON keys.
+    /// the skipped section, section 6 after the thesis table, the summary, headline and JSON
+    /// keys.
     #[test]
     fn report_from_known_units() {
         let units = [
@@ -313,6 +323,7 @@ mod tests {
                 vocabulary_note: "Vocabulary 3-D.".into(),
             },
             UnitResult::Skipped,
+            UnitResult::Nordland(section("Nordland: 7/10.")),
         ];
         let results: Vec<(String, Value)> = units
             .iter()
@@ -343,10 +354,13 @@ mod tests {
         assert!(at("* `kitti-poles/02` not found: sequence skipped.") < at("## 4."));
         assert!(at("## 4. Speed\n\nSkipped (`PLACE_RECOGNITION_SECTIONS`).") < at("## 5."));
         assert!(at("| no — semi-synthetic") > 0);
+        assert!(
+            at("## 6. Real camera seasons (Nordland)\n\nText of Nordland: 7/10.") > at("## 5.")
+        );
         assert_eq!(
             page.headline.as_deref(),
             Some(
-                "Real 3-D: 9/10; Real 2-D (CARMEN): IBuILD recall at 100 % precision ≥ \
+                "Nordland: 7/10; Real 3-D: 9/10; Real 2-D (CARMEN): IBuILD recall at 100 % precision ≥ \
                  DBoW2-style on 2 of 3 logs online and 3 of 3 kidnapped."
             )
         );
@@ -355,6 +369,7 @@ mod tests {
         assert_eq!(
             keys,
             [
+                "nordland",
                 "real_2d",
                 "real_3d",
                 "semi_kitti",
@@ -369,7 +384,7 @@ mod tests {
         assert_eq!(page.json["semi_kitti"]["missing"], json!(["02"]));
         assert!(page.json["speed"].is_null());
         assert_eq!(page.json["vocabulary_3d"], "Vocabulary 3-D.");
-        assert_eq!(page.json["summary"].as_array().unwrap().len(), 4);
+        assert_eq!(page.json["summary"].as_array().unwrap().len(), 5);
     }
 
     #[test]

@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use raypath_geometry::{Pose3, Scan2};
+use raypath_io::images::ImageFolder;
 use raypath_io::sequence::{PlanarFrame, PlanarSource, SweepFormat, SweepSequence};
 use raypath_place_recognition::{OwnedFrame, PlaceError};
 
@@ -20,8 +21,8 @@ pub enum Source {
     Planar(Vec<Scan2>),
     /// 3-D sweeps; read one at a time.
     Sweeps(Box<SweepSequence>),
-    /// Image files in name order; decoded one at a time.
-    Images(Vec<PathBuf>),
+    /// Image files in name order (read by `raypath_io::images`); decoded one at a time.
+    Images(ImageFolder),
 }
 
 /// The input of the command.
@@ -44,6 +45,9 @@ pub struct Input {
     pub poses: Option<Vec<Option<Pose3>>>,
     /// Number of frames before `--max-frames`.
     pub total: usize,
+    /// Images: the size every image must have (`--database`: the first database image's),
+    /// else any size.
+    pub image_size: Option<(u32, u32)>,
 }
 
 impl Input {
@@ -55,6 +59,18 @@ impl Input {
     /// What the frames are, in words.
     pub fn kind(&self) -> &'static str {
         self.kind
+    }
+
+    /// The file names of image input (`None` for other input).
+    pub fn image_names(&self) -> Option<Vec<String>> {
+        match &self.source {
+            Source::Images(folder) => Some(
+                (0..self.len())
+                    .map(|i| folder.name(i).unwrap_or_default())
+                    .collect(),
+            ),
+            _ => None,
+        }
     }
 
     /// True for planar scans.
@@ -89,13 +105,14 @@ impl Input {
                 .sweep(i)
                 .map(OwnedFrame::Cloud)
                 .map_err(|e| PlaceError::BadInput(e.to_string())),
-            Source::Images(files) => {
-                let path = files
-                    .get(i)
-                    .ok_or_else(|| PlaceError::BadInput(format!("no image {i}")))?;
-                let image = image::open(path)
-                    .map_err(|e| PlaceError::BadInput(format!("{}: {e}", path.display())))?;
-                Ok(OwnedFrame::Image(image.to_luma8()))
+            Source::Images(folder) => {
+                let image = match self.image_size {
+                    Some((w, h)) => folder.read_sized(i, w, h),
+                    None => folder.read(i),
+                };
+                image
+                    .map(OwnedFrame::Image)
+                    .map_err(|e| PlaceError::BadInput(e.to_string()))
             }
         }
     }
@@ -178,6 +195,7 @@ fn read_planar(
         kind,
         times,
         total: 0,
+        image_size: None,
     })
 }
 
@@ -198,6 +216,7 @@ fn read_sweeps(path: &Path, sequence: SweepSequence) -> Input {
         kind,
         source: Source::Sweeps(Box::new(sequence)),
         total: 0,
+        image_size: None,
     }
 }
 
@@ -219,38 +238,24 @@ fn frame_numbers(sequence: &SweepSequence) -> Vec<usize> {
     }
 }
 
-fn read_images(path: &Path) -> Result<Input, Failure> {
-    let entries =
-        std::fs::read_dir(path).map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
-    let mut files = Vec::new();
-    for entry in entries {
-        let entry = entry.map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
-        let file = entry.path();
-        let image_ext = file
-            .extension()
-            .and_then(|e| e.to_str())
-            .is_some_and(|e| matches!(e.to_ascii_lowercase().as_str(), "png" | "jpg" | "jpeg"));
-        if image_ext && file.is_file() {
-            files.push(file);
-        }
-    }
-    if files.is_empty() {
-        return Err(Failure::input(format!(
-            "{}: neither a KITTI sequence (velodyne/*.bin), an NCLT session \
-                 (velodyne_sync/*.bin), a rosbag2 bag nor a folder of PNG/JPEG images",
-            path.display()
-        )));
-    }
-    files.sort_by(|a, b| a.file_name().cmp(&b.file_name()));
-    let times: Option<Vec<f64>> = files.iter().map(|f| stamp_of(f)).collect();
+/// Reads a folder of PNG/JPEG images (`raypath_io::images`).
+pub fn read_images(path: &Path) -> Result<Input, Failure> {
+    let folder = ImageFolder::open(path).map_err(|e| {
+        Failure::input(format!(
+            "{e} (the input is neither a KITTI sequence (velodyne/*.bin), an NCLT session \
+             (velodyne_sync/*.bin), a rosbag2 bag nor a folder of PNG/JPEG images)"
+        ))
+    })?;
+    let times: Option<Vec<f64>> = folder.files().iter().map(|f| stamp_of(f)).collect();
     Ok(Input {
         path: path.to_path_buf(),
-        labels: (0..files.len()).collect(),
-        source: Source::Images(files),
+        labels: (0..folder.len()).collect(),
+        total: folder.len(),
+        source: Source::Images(folder),
         poses: None,
         kind: "images",
         times,
-        total: 0,
+        image_size: None,
     })
 }
 
