@@ -332,8 +332,9 @@ pub fn run(ctx: &EvalContext, vocabulary: Option<&Arc<BinaryVocabulary>>) -> Res
         stats.to_markdown()?
     )?;
     let summary = vec![format!(
-        "Real 3-D ({} real frames of {}, kidnapped; counted over the {n} with another frame of \
-         their own source): best match in the same source — {}.",
+        "Real 3-D, no revisits (a sanity check, not a place-recognition result; {} real \
+         frames of {}, kidnapped; counted over the {n} with another frame of their own source): \
+         best match in the same source — {}.",
         frames.len(),
         found.join(", "),
         fractions.join(", ")
