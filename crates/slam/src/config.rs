@@ -195,10 +195,9 @@ pub struct SlamConfig {
     /// pose of the node in each submap: Hess et al. 2016's intra-submap constraints), which
     /// keeps each submap rigid in the graph. Default true.
     pub intra_submap_edges: bool,
-    /// σ of a loop constraint. Default (0.015 m, 0.015 m, 0.3°) (ours): tighter than the
-    /// 5 cm / 1° we started from, which let the pose graph bend loops apart on the raw Intel and
-    /// MIT CSAIL logs (relation-file error 0.0196 → 0.0189 m and 0.0294 → 0.0288 m in our
-    /// `relation_diagnosis` runs); the large-loop logs close better too.
+    /// σ of a loop constraint. Default (0.015 m, 0.015 m, 0.3°) (ours, chosen on the raw Intel
+    /// and MIT CSAIL logs): tighter than the 5 cm / 1° we started from, which let the pose graph
+    /// bend the relations across loops; the figures are in `docs/results/slam.md`.
     pub loop_sigma: Sigmas,
     /// The pose-graph solver (robust kernel on loop edges).
     pub solver: SolverConfig,
