@@ -138,9 +138,9 @@ pub struct Annealing {
     /// down-weighted in the first iteration. Default 1e5 (ours; an error of ≈ 300 widths in
     /// √χ²: about 9 m for a loop edge of σ = 5 cm under DCS with Φ = 10), which bounds the
     /// schedule to 17 iterations with the default factor. The first loops that close a long
-    /// excursion meet a guess metres off (about 8 m on the raw MIT Killian Court log); with a
-    /// bound of 1e3 they started down-weighted, never pulled, and were rejected at the end,
-    /// leaving the map doubled.
+    /// excursion meet a guess metres off (the raw MIT Killian Court log's, in
+    /// `docs/results/slam.md`); with a bound of 1e3 they started down-weighted, never pulled,
+    /// and were rejected at the end, leaving the map doubled.
     pub max_start: f64,
     /// Division of `μ` per iteration (> 1). Default 2: on the M3500-style graph of the
     /// benchmark (from the chained-odometry guess) it reaches the same optimum as the 1.4 of
