@@ -2,8 +2,8 @@
 //!
 //! The geometric core every raypath crate stands on: poses in SE(2) and SE(3), rays with
 //! hits and no-returns, axis-aligned boxes, uniform grids, **exact ray traversal** that reports
-//! the length a ray travels inside every cell, point clouds, planar scans and organized range
-//! images.
+//! the length a ray travels inside every cell, point clouds, planar scans (with point-to-line
+//! ICP between two of them) and organized range images.
 //!
 //! ## Concepts
 //!
@@ -47,6 +47,7 @@ mod aabb;
 mod error;
 mod grid;
 mod lane_dot;
+mod line_icp;
 mod point_cloud;
 mod pose;
 mod range_image;
@@ -61,6 +62,7 @@ pub use aabb::{Aabb2, Aabb3};
 pub use error::GeometryError;
 pub use grid::{Grid2, Grid3};
 pub use lane_dot::lane_dot;
+pub use line_icp::{LineAlignment, LineIcp, LineTarget, MIN_CORRESPONDENCES, line_normal};
 pub use point_cloud::PointCloud;
 pub use pose::{Pose2, Pose3, wrap_angle};
 pub use range_image::{

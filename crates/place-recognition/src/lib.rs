@@ -17,6 +17,7 @@
 //! | [`ScanContext`] | clouds | max height per ring × sector, ring key in a k-d tree, column-shift cosine distance | Kim & Kim, IROS 2018 (from the paper) |
 //! | [`PolarContext`] | planar scans | the same idea for 2-D scans (end-point counts per ring × sector) | ours |
 //! | [`RawPixels`] | same as the images | downsampled, patch-normalised pixels, mean absolute difference (SeqSLAM's single-image comparison) | Milford & Wyeth 2012 |
+//! | [`GeometricCheck`] | planar scans | any method above, its best candidates re-scored by how well the two scans align (point-to-line ICP, share of supported points) | ours |
 //!
 //! Any method's scores of a query sequence against a database sequence ([`run_cross`], a
 //! [`ScoreMatrix`]) can feed **sequence matching** ([`sequence_match`], SeqSLAM: difference
@@ -149,6 +150,9 @@ mod online;
 mod pr;
 mod run;
 
+// The geometric check of candidates on planar scans (ours).
+mod verify;
+
 // Query sequence against a database sequence (Nordland), the raw-pixel baseline and
 // sequence matching (SeqSLAM, Milford & Wyeth 2012).
 mod cross;
@@ -158,6 +162,7 @@ mod seqslam;
 pub use binary::{BinaryDescriptor, Bits256, Bits512};
 pub use error::{PlaceError, Result};
 pub use frame::{Candidate, Frame, OwnedFrame, PlaceRecognizer};
+pub use verify::{Checked, GeometricCheck, GeometricCheckConfig};
 
 // --- features (features work) ---
 pub use features::{FeatureConfig, Keypoint, detect_and_describe};

@@ -1,9 +1,9 @@
 //! Scan-refined relations: reference relations refined by aligning their own two scans,
 //! kept where that alignment is unique and well constrained ([`refine_relations`]).
 
-use crate::polish::line_normal;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use nalgebra::{Matrix2, Matrix3, Point2, Vector2, Vector3};
+use raypath_geometry::line_normal;
 use raypath_geometry::{Pose2, Scan2};
 
 use super::{near_points, reference_pair};

@@ -1,5 +1,5 @@
 //! Final polishing (ours): after the last optimisation of the node graph, every scan — not
-//! only the nodes — is aligned by point-to-line ICP (`icp.rs`) to the next
+//! only the nodes — is aligned by point-to-line ICP ([`raypath_geometry::LineTarget`]) to the next
 //! [`PolishConfig::neighbours`] scans, each node's scan also to the scans of nodes that
 //! revisit its place ([`PolishConfig::revisits`]), and one pose graph over all scans is
 //! solved: the node graph's own edges (sequential, intra-submap, the accepted loop closures),
@@ -19,17 +19,13 @@
 //! edges decide there. Alignments that move the relative pose farther than
 //! [`PolishConfig::max_correction`] are dropped (the ICP left its basin).
 
-pub(crate) mod icp;
-
 use nalgebra::Matrix3;
 use rayon::prelude::*;
-use raypath_geometry::Pose2;
+use raypath_geometry::{LineIcp, LineTarget, Pose2};
 
 use crate::error::{Result, SlamError, require_positive};
 use crate::graph::{Edge, EdgeKind, PoseGraph, SolverConfig};
 use crate::output::ScanPose;
-use icp::LineTarget;
-pub(crate) use icp::line_normal;
 
 /// Settings of the polishing stage ([`crate::SlamConfig::polish`], off by default); the
 /// defaults are ours, chosen on the Intel and MIT CSAIL logs' relation files (fr079 held out).
@@ -96,6 +92,15 @@ impl Default for PolishConfig {
 }
 
 impl PolishConfig {
+    /// The ICP iteration settings of these.
+    pub(crate) fn icp(&self) -> LineIcp<'_> {
+        LineIcp {
+            gates_m: &self.gates_m,
+            iterations: self.iterations,
+            kernel_m: self.kernel_m,
+        }
+    }
+
     /// Checks the settings (errors name the field).
     pub fn validate(&self) -> Result<()> {
         if self.neighbours == 0
@@ -238,7 +243,7 @@ fn scan_edge(
     config: &PolishConfig,
 ) -> Option<ScanEdge> {
     let start = poses[i].inverse() * poses[j];
-    let a = target.align(source, start, config)?;
+    let a = target.align(source, start, &config.icp())?;
     let moved = start.inverse() * a.target_from_source;
     if moved.translation().norm() > config.max_correction.0
         || moved.theta().abs() > config.max_correction.1

@@ -2,8 +2,8 @@ use std::f64::consts::TAU;
 
 use raypath_geometry::{Pose2, Scan2};
 
-use super::icp::LineTarget;
 use super::*;
+use raypath_geometry::LineTarget;
 
 type Wall = ([f64; 2], [f64; 2]);
 
@@ -68,7 +68,9 @@ fn icp_reaches_the_true_relative_pose() {
     let target = LineTarget::new(&points_at(&walls, a), config.normal_radius_m).unwrap();
     let truth = a.inverse() * b;
     let start = truth * Pose2::new(0.03, -0.025, 1f64.to_radians());
-    let aligned = target.align(&points_at(&walls, b), start, &config).unwrap();
+    let aligned = target
+        .align(&points_at(&walls, b), start, &config.icp())
+        .unwrap();
     let (t, r) = off_by(truth, aligned.target_from_source);
     assert!(t < 1e-3 && r < 1e-4, "{t} m, {r} rad off");
     assert!(aligned.used > 100);
@@ -85,7 +87,7 @@ fn a_corridor_leaves_its_axis_without_information() {
     let config = PolishConfig::default();
     let target = LineTarget::new(&points_at(&walls, a), config.normal_radius_m).unwrap();
     let aligned = target
-        .align(&points_at(&walls, b), a.inverse() * b, &config)
+        .align(&points_at(&walls, b), a.inverse() * b, &config.icp())
         .unwrap();
     let h = aligned.mean_information;
     assert!(h[(0, 0)] < 1e-3 * h[(1, 1)], "{h}");

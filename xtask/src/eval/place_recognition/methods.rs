@@ -6,9 +6,10 @@ use std::sync::Arc;
 use anyhow::Result;
 use image::GrayImage;
 use raypath_place_recognition::{
-    BinaryVocabulary, Bits512, Dbow, DbowConfig, FeatureConfig, GistConfig, GlobalDescriptorDb,
-    HogConfig, Ibuild, IbuildConfig, IbuildScore, ImageConfig, PolarConfig, PolarContext,
-    ScanContext, ScanContextConfig, Shot3dBow, Shot3dBowConfig, ShotConfig, VocabularyConfig,
+    BinaryVocabulary, Bits512, Checked, Dbow, DbowConfig, FeatureConfig, GeometricCheck,
+    GeometricCheckConfig, GistConfig, GlobalDescriptorDb, HogConfig, Ibuild, IbuildConfig,
+    IbuildScore, ImageConfig, PlaceError, PolarConfig, PolarContext, ScanContext,
+    ScanContextConfig, Shot3dBow, Shot3dBowConfig, ShotConfig, VocabularyConfig,
     detect_and_describe,
 };
 
@@ -181,16 +182,98 @@ pub fn shot(with_intensity: bool) -> Result<Box<dyn Runner>> {
     ))
 }
 
+/// The suffix of a method's label with the geometric check.
+pub const CHECKED: &str = " + geometric check";
+
+/// The geometric check of the 2-D logs: the defaults, and in kidnapped mode no frame within
+/// the ground truth's exclusion window is checked (such pairs are not scored).
+fn check_config() -> GeometricCheckConfig {
+    GeometricCheckConfig {
+        exclude_recent: super::truth::MIN_GAP_FRAMES,
+        ..GeometricCheckConfig::default()
+    }
+}
+
+/// IBuILD (default δ, printed or symmetric score) with the geometric check on the planar scans.
+fn ibuild_checked(score: IbuildScore, label: &str) -> Result<Box<dyn Runner>> {
+    fn describe(
+        m: &mut GeometricCheck<Ibuild>,
+        s: &Sample<'_>,
+        input: Input,
+    ) -> raypath_place_recognition::Result<(
+        Checked<raypath_place_recognition::IbuildDescription>,
+        f64,
+    )> {
+        let f = features_of(s, input)?;
+        let d = m.inner_mut().describe_descriptors(f.descriptors.clone());
+        Ok((m.attach(d, planar_scan(s)?), f.seconds))
+    }
+    let ibuild = Ibuild::new(IbuildConfig {
+        delta: DEFAULT_DELTA,
+        score,
+        ..IbuildConfig::default()
+    })?;
+    Ok(boxed_features(
+        GeometricCheck::new(ibuild, check_config())?,
+        format!("{label}{CHECKED}"),
+        Input::Planar,
+        describe,
+    ))
+}
+
+/// The DBoW2-style baseline with the geometric check on the planar scans.
+fn dbow_checked(vocabulary: &Arc<BinaryVocabulary>) -> Result<Box<dyn Runner>> {
+    fn describe(
+        m: &mut GeometricCheck<Dbow>,
+        s: &Sample<'_>,
+        input: Input,
+    ) -> raypath_place_recognition::Result<(Checked<raypath_place_recognition::DbowDescription>, f64)>
+    {
+        let f = features_of(s, input)?;
+        let d = m
+            .inner_mut()
+            .describe_descriptors(f.keypoints.clone(), &f.descriptors);
+        Ok((m.attach(d, planar_scan(s)?), f.seconds))
+    }
+    let dbow = Dbow::new(Arc::clone(vocabulary), DbowConfig::default());
+    Ok(boxed_features(
+        GeometricCheck::new(dbow, check_config())?,
+        format!("DBoW2-style{CHECKED}"),
+        Input::Planar,
+        describe,
+    ))
+}
+
+/// The planar scan of a sample.
+fn planar_scan<'a>(
+    s: &Sample<'a>,
+) -> raypath_place_recognition::Result<&'a raypath_geometry::Scan2> {
+    match s.frame(Input::Planar) {
+        Some(raypath_place_recognition::Frame::Planar(scan)) => Ok(scan),
+        _ => Err(PlaceError::BadInput(
+            "no planar scan for the geometric check".into(),
+        )),
+    }
+}
+
 /// The methods of the real 2-D logs: IBuILD and DBoW2-style on rasterised scans, planar
-/// polar context.
+/// polar context; each also with the geometric check.
 pub fn planar(vocabulary: Option<&Arc<BinaryVocabulary>>) -> Result<Vec<Box<dyn Runner>>> {
     let mut out = vec![
         ibuild(Input::Planar, DEFAULT_DELTA)?,
         ibuild_symmetric(Input::Planar)?,
         polar()?,
+        ibuild_checked(IbuildScore::default(), "IBuILD")?,
+        ibuild_checked(IbuildScore::Symmetric, SYMMETRIC_IBUILD)?,
+        boxed(
+            GeometricCheck::new(PolarContext::new(PolarConfig::default())?, check_config())?,
+            format!("polar context{CHECKED}"),
+            Input::Planar,
+        ),
     ];
     if let Some(v) = vocabulary {
         out.push(dbow(v, Input::Planar));
+        out.push(dbow_checked(v)?);
     }
     for delta in DELTAS {
         if delta != DEFAULT_DELTA {

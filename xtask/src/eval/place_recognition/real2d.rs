@@ -201,10 +201,78 @@ pub struct LogRows {
     pub aim: Vec<String>,
     /// The same for the symmetric IBuILD (shown, not counted in the summary).
     pub symmetric_aim: Vec<String>,
+    /// The aim rows of the geometric check ([`checked_aims`]).
+    #[serde(default)]
+    pub checked_aims: Vec<Vec<String>>,
     /// The PR pictures (markdown; the PNGs are written by the unit).
     pub pictures: String,
     /// The log's figures for the JSON.
     pub json: Value,
+}
+
+/// The IBuILD variants measured against the baselines with the geometric check, each a fixed
+/// choice for every log (none picked per log after the fact).
+pub const CHECKED_VARIANTS: [&str; 2] = ["IBuILD", methods::SYMMETRIC_IBUILD];
+
+/// Recall at 100 % precision of the method labelled `label` on the rasterised scans.
+fn recall_at_100(results: &[MethodResult], label: &str, online: bool) -> Option<f64> {
+    let key = format!("{label} ({})", Input::Planar.name());
+    let r = results.iter().find(|r| r.key() == key)?;
+    let summary = if online {
+        r.online_summary()
+    } else {
+        r.kidnapped_summary()
+    };
+    summary.map(|s| s.recall_at_100_precision)
+}
+
+/// "yes", "tie at 0" or "**no**": `ours` ≥ every one of `baselines`.
+fn holds(ours: Option<f64>, baselines: &[Option<f64>]) -> String {
+    let Some(a) = ours else {
+        return "—".into();
+    };
+    let known: Vec<f64> = baselines.iter().flatten().copied().collect();
+    if known.is_empty() {
+        "—".into()
+    } else if a == 0.0 && known.iter().all(|&b| b == 0.0) {
+        "tie at 0".into()
+    } else if known.iter().all(|&b| a >= b) {
+        "yes".into()
+    } else {
+        "**no**".into()
+    }
+}
+
+/// Per IBuILD variant and mode: the variant with the geometric check against DBoW2-style and
+/// polar context with the same check (like for like) and without it.
+fn checked_aims(name: &str, results: &[MethodResult]) -> Vec<Vec<String>> {
+    use methods::CHECKED;
+    let mut rows = Vec::new();
+    for variant in CHECKED_VARIANTS {
+        for online in [true, false] {
+            let r = |label: &str| recall_at_100(results, label, online);
+            let ours = r(&format!("{variant}{CHECKED}"));
+            let checked = [
+                r(&format!("DBoW2-style{CHECKED}")),
+                r(&format!("polar context{CHECKED}")),
+            ];
+            let plain = [r("DBoW2-style"), r("polar context")];
+            rows.push(vec![
+                name.to_string(),
+                "real".into(),
+                format!("{variant}{CHECKED}"),
+                if online { "online" } else { "kidnapped" }.into(),
+                super::report::pct(ours),
+                super::report::pct(checked[0]),
+                super::report::pct(checked[1]),
+                holds(ours, &checked),
+                super::report::pct(plain[0]),
+                super::report::pct(plain[1]),
+                holds(ours, &plain),
+            ]);
+        }
+    }
+    rows
 }
 
 /// The position of each log of this run in the report (the order of [`LOGS`]).
@@ -289,6 +357,7 @@ fn run_log(
             &format!("{} (rasterised scan)", methods::SYMMETRIC_IBUILD),
             "DBoW2-style (rasterised scan)",
         ),
+        checked_aims: checked_aims(name, &results),
         pictures: format!("**{name}**\n\n")
             + &pr_figures(figures, FIGURES, &format!("2d-{name}"), &results)?,
         json: json!({
