@@ -241,3 +241,50 @@ fn bad_input_exits_2_with_file_and_place() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("bad.txt: line 1"));
 }
+
+/// `--geometric-check` on a real log: every accepted loop's score is a support share in
+/// [0.3, 1], and recall at 100 % precision is no lower than without the check.
+#[test]
+fn geometric_check_on_a_real_log() {
+    let Some(log) = require("carmen/corrected/csail-corrected.log.gz") else {
+        return;
+    };
+    let log = log.to_str().unwrap();
+    let run = |extra: &[&str]| {
+        let args = [
+            &[
+                "loop-closure",
+                log,
+                "--method",
+                "polar",
+                "--ground-truth",
+                log,
+                "--json",
+            ][..],
+            extra,
+        ]
+        .concat();
+        json_of(&raypath(&args))
+    };
+    let (plain, checked) = (run(&[]), run(&["--geometric-check"]));
+    check_keys(&checked, true);
+    for l in checked["loops"].as_array().unwrap() {
+        let s = l["score"].as_f64().unwrap();
+        assert!((0.3..=1.0).contains(&s), "{l}");
+    }
+    let recall = |d: &serde_json::Value| d["summary"]["recall_at_100_precision"].as_f64().unwrap();
+    assert!(recall(&checked) >= recall(&plain), "{checked} vs {plain}");
+    // Images cannot be checked geometrically: exit 2 naming the reason.
+    let dir = tempfile::tempdir().unwrap();
+    write_folder(dir.path());
+    let images = dir.path().join("images");
+    let out = raypath(&[
+        "loop-closure",
+        images.to_str().unwrap(),
+        "--method",
+        "hog",
+        "--geometric-check",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("geometric check"));
+}

@@ -162,7 +162,7 @@ mod seqslam;
 pub use binary::{BinaryDescriptor, Bits256, Bits512};
 pub use error::{PlaceError, Result};
 pub use frame::{Candidate, Frame, OwnedFrame, PlaceRecognizer};
-pub use verify::{Checked, GeometricCheck, GeometricCheckConfig};
+pub use verify::{Checked, GeometricCheck, GeometricCheckConfig, ScanMatch};
 
 // --- features (features work) ---
 pub use features::{FeatureConfig, Keypoint, detect_and_describe};

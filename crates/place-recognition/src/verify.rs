@@ -48,6 +48,11 @@ pub struct GeometricCheckConfig {
     /// Points closer than this to the previous kept point along the scan are left out,
     /// metres (thins dense near walls). Default 0.05.
     pub min_spacing_m: f64,
+    /// A match whose two sensors are farther apart than this is no place match (support 0),
+    /// metres: the application's notion of "the same place". Default ∞.
+    pub max_offset_m: f64,
+    /// … or whose headings differ by more than this, radians. Default π (any).
+    pub max_heading_rad: f64,
     /// [`PlaceRecognizer::query_stored`] neither checks nor proposes frames within this many
     /// of the queried frame (its own recent past, as the online exclusion window). Default 0.
     pub exclude_recent: usize,
@@ -66,6 +71,8 @@ impl Default for GeometricCheckConfig {
             min_support: 0.3,
             max_range_m: 15.0,
             min_spacing_m: 0.05,
+            max_offset_m: f64::INFINITY,
+            max_heading_rad: std::f64::consts::PI,
             exclude_recent: 0,
         }
     }
@@ -100,6 +107,13 @@ impl GeometricCheckConfig {
         require_positive("normal_radius_m", self.normal_radius_m)?;
         require_positive("support_m", self.support_m)?;
         require_positive("max_range_m", self.max_range_m)?;
+        if self.max_offset_m.is_nan() || self.max_offset_m <= 0.0 {
+            return Err(PlaceError::InvalidParameter {
+                name: "max_offset_m",
+                reason: format!("must be positive (∞ allowed), got {}", self.max_offset_m),
+            });
+        }
+        require_positive("max_heading_rad", self.max_heading_rad)?;
         if !(0.0..=1.0).contains(&self.min_support) {
             return Err(PlaceError::InvalidParameter {
                 name: "min_support",
@@ -114,6 +128,15 @@ impl GeometricCheckConfig {
         }
         Ok(())
     }
+}
+
+/// The best alignment of two scans found by the check.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScanMatch {
+    /// The smaller of the two scans' shares of supported points.
+    pub support: f64,
+    /// The pose of the second scan's sensor in the first's.
+    pub a_from_b: Pose2,
 }
 
 /// A scan's points (sensor frame, thinned) indexed for alignment; `None` when too few.
@@ -183,20 +206,28 @@ impl<R: PlaceRecognizer> GeometricCheck<R> {
         CheckedScan(LineTarget::new(&points, c.normal_radius_m))
     }
 
-    /// The support of the best alignment of scan `b` onto scan `a` over the start headings
-    /// (0 when either scan is too sparse or no alignment succeeds).
-    fn support(&self, a: &CheckedScan, b: &CheckedScan) -> f64 {
+    /// The best alignment of scan `b` onto scan `a` (module docs): every start heading runs
+    /// the coarse gates on every second point of `b`; the start whose result `b` supports most
+    /// runs the last gate on all points and is scored both ways. Support 0 when either scan is
+    /// too sparse or no alignment succeeds.
+    fn best_alignment(&self, a: &CheckedScan, b: &CheckedScan) -> ScanMatch {
+        let none = ScanMatch {
+            support: 0.0,
+            a_from_b: Pose2::identity(),
+        };
         let (Some(a), Some(b)) = (&a.0, &b.0) else {
-            return 0.0;
+            return none;
         };
         let c = &self.config;
-        let icp = LineIcp {
-            gates_m: &c.gates_m,
+        let (coarse, fine) = c.gates_m.split_at(c.gates_m.len() - 1);
+        let icp = |gates_m| LineIcp {
+            gates_m,
             iterations: c.iterations,
             kernel_m: c.kernel_m,
         };
+        let thinned: Vec<[f64; 2]> = b.points().iter().step_by(2).copied().collect();
         let (ca, cb) = (centroid(a.points()), centroid(b.points()));
-        let mut best: f64 = 0.0;
+        let mut best: Option<(f64, Pose2)> = None;
         for k in 0..c.start_headings {
             let heading = std::f64::consts::TAU * k as f64 / c.start_headings as f64;
             // The start puts the centroids of the two point sets on each other.
@@ -206,18 +237,49 @@ impl<R: PlaceRecognizer> GeometricCheck<R> {
                 ca[1] - (sin * cb[0] + cos * cb[1]),
                 heading,
             );
-            let Some(found) = a.align(b.points(), start, &icp) else {
+            let pose = match coarse.is_empty() {
+                true => Some(start),
+                false => a
+                    .align(&thinned, start, &icp(coarse))
+                    .map(|m| m.target_from_source),
+            };
+            let Some(pose) = pose else {
                 continue;
             };
-            let pose = found.target_from_source;
-            let b_on_a = a.support(b.points(), &pose, c.support_m);
-            if b_on_a <= best {
-                continue;
+            let support = a.support(&thinned, &pose, c.support_m);
+            if best.is_none_or(|(s, _)| support > s) {
+                best = Some((support, pose));
             }
-            let a_on_b = b.support(a.points(), &pose.inverse(), c.support_m);
-            best = best.max(b_on_a.min(a_on_b));
         }
-        best
+        let Some((_, start)) = best else {
+            return none;
+        };
+        let Some(found) = a.align(b.points(), start, &icp(fine)) else {
+            return none;
+        };
+        let pose = found.target_from_source;
+        let b_on_a = a.support(b.points(), &pose, c.support_m);
+        let a_on_b = b.support(a.points(), &pose.inverse(), c.support_m);
+        ScanMatch {
+            support: b_on_a.min(a_on_b),
+            a_from_b: pose,
+        }
+    }
+
+    /// The support of the best alignment (0 when it is no place match, see
+    /// [`GeometricCheckConfig::max_offset_m`]).
+    fn support(&self, a: &CheckedScan, b: &CheckedScan) -> f64 {
+        let m = self.best_alignment(a, b);
+        let c = &self.config;
+        let near = m.a_from_b.translation().norm() <= c.max_offset_m
+            && m.a_from_b.theta().abs() <= c.max_heading_rad;
+        if near { m.support } else { 0.0 }
+    }
+
+    /// Aligns two scans as the check does (from every start heading) and returns the best
+    /// match, whatever its offset.
+    pub fn match_scans(&self, a: &Scan2, b: &Scan2) -> ScanMatch {
+        self.best_alignment(&self.index(a), &self.index(b))
     }
 
     /// The inner candidates (any order) checked against `scan`, best support first.

@@ -5,7 +5,8 @@
 //! * **Real 2-D** ([`real2d`]): the corrected CARMEN logs with loops (real scans; the
 //!   SLAM-corrected poses are the ground truth). IBuILD and DBoW2-style on rasterised scans
 //!   (the DBoW2-style vocabulary trained offline on the logs of the other fold), planar polar
-//!   context. Online loop closure and kidnapped mode; PR curves as PNG.
+//!   context, each also with the geometric check (`GeometricCheck`). Online loop closure and
+//!   kidnapped mode; PR curves as PNG.
 //! * **Real 3-D** ([`kitti_real`]): the 40 real KITTI frames and 5 real Ouster frames (KITTI sequences 00, 01, 04, 07, ten
 //!   each) in one database, kidnapped: is each frame's best match a neighbour of the same
 //!   sequence? Real intensity-image statistics beside simulated frames at the same poses.

@@ -10,6 +10,10 @@
 //! 2. Images smaller than 128 px on their shorter side are enlarged for the feature stages of
 //! `ibuild` and `dbow` (`--upscale`).
 //!
+//! `--geometric-check` (planar scans): each query's best candidates are re-scored by how well
+//! the two scans align (`raypath_place_recognition::GeometricCheck`); scores are then shares
+//! of supported points in [0.3, 1].
+//!
 //! `--database DIR`: the input folder's images are queries against the database folder's
 //! images, ground truth by file name ± `--tolerance` frames, optional sequence matching
 //! `--sequence D_S` (SeqSLAM) — see `cross`; the modes below do not apply.
@@ -59,11 +63,12 @@ use nalgebra::Point3;
 use raypath_geometry::Pose3;
 use raypath_io::foxglove::{frame, topic};
 use raypath_place_recognition::{
-    BinaryVocabulary, Candidate, Dbow, DbowConfig, Exclusion, FrameTiming, GlobalDescriptorDb,
-    GroundTruth, Ibuild, IbuildConfig, IbuildScore, ImageConfig, KidnappedRun, LoopClosure,
-    LoopConfig, OwnedFrame, PlaceError, PlaceRecognizer, PolarContext, PrSummary, RawPixelConfig,
-    RawPixels, ScanContext, Shot3dBow, VocabularyConfig, detect_and_describe, detect_loops,
-    frame_image, kidnapped_pr, online_pr, run_kidnapped, run_online,
+    BinaryVocabulary, Candidate, Dbow, DbowConfig, Exclusion, FrameTiming, GeometricCheck,
+    GeometricCheckConfig, GlobalDescriptorDb, GroundTruth, Ibuild, IbuildConfig, IbuildScore,
+    ImageConfig, KidnappedRun, LoopClosure, LoopConfig, OwnedFrame, PlaceError, PlaceRecognizer,
+    PolarContext, PrSummary, RawPixelConfig, RawPixels, ScanContext, Shot3dBow, VocabularyConfig,
+    detect_and_describe, detect_loops, frame_image, kidnapped_pr, online_pr, run_kidnapped,
+    run_online,
 };
 use serde_json::json;
 
@@ -184,6 +189,10 @@ pub struct Args {
     /// smallest K that gives images a shorter side of at least 128 px; 1 for larger images).
     #[arg(long, value_name = "K")]
     pub upscale: Option<u32>,
+    /// Planar scans: re-score each query's best candidates by how well the two scans align
+    /// (point-to-line ICP from 8 headings; score = share of points both scans support).
+    #[arg(long)]
+    pub geometric_check: bool,
     /// How to read the input and the ground truth.
     #[command(flatten)]
     pub source: SourceArgs,
@@ -266,14 +275,15 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             Some((path, ground_truth(path, &args.source, &input, &params)?))
         }
     };
-    let outcome = dispatch(
+    let execute = Execute {
         args,
-        &input,
-        Execute {
-            args,
-            input: &input,
-        },
-    )?;
+        input: &input,
+    };
+    let outcome = if args.geometric_check {
+        dispatch(args, &input, WithCheck(execute))?
+    } else {
+        dispatch(args, &input, execute)?
+    };
     let config = loop_config(args);
     let place = |e: PlaceError| Failure::input(format!("{}: {e}", args.input.display()));
     let loops = detect_loops(&config, &outcome.candidates).map_err(place)?;
@@ -447,6 +457,23 @@ impl WithRecognizer for Execute<'_> {
     type Output = Outcome;
     fn run<R: PlaceRecognizer + Sync>(self, recognizer: R) -> Result<Outcome, Failure> {
         execute(recognizer, self.args, self.input)
+    }
+}
+
+/// `--geometric-check`: the recognizer wrapped in a [`GeometricCheck`] before it runs.
+struct WithCheck<'a>(Execute<'a>);
+
+impl WithRecognizer for WithCheck<'_> {
+    type Output = Outcome;
+    fn run<R: PlaceRecognizer + Sync>(self, recognizer: R) -> Result<Outcome, Failure> {
+        let args = self.0.args;
+        let config = GeometricCheckConfig {
+            exclude_recent: args.exclusion_frames,
+            ..GeometricCheckConfig::default()
+        };
+        let checked = GeometricCheck::new(recognizer, config)
+            .map_err(|e| Failure::input(format!("{}: {e}", args.input.display())))?;
+        self.0.run(checked)
     }
 }
 

@@ -189,4 +189,3 @@ fn bad_input_is_refused_or_empty() {
         assert!(e.to_string().contains(name), "{e}");
     }
 }
-

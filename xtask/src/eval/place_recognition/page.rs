@@ -246,6 +246,7 @@ mod tests {
             sweep: vec![cells(8)],
             aim: aim(name, online, "yes"),
             symmetric_aim: aim(&format!("{name} (sym)"), "yes", "yes"),
+            checked_aims: Vec::new(),
             pictures: format!("![{name}](x.png)\n\n"),
             json: json!({ "log": name }),
         }))
