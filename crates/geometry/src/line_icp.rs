@@ -242,7 +242,10 @@ mod tests {
         let start = truth * Pose2::new(0.05, -0.03, 2f64.to_radians());
         let found = target.align(&source, start, &icp).unwrap();
         let d = truth.inverse() * found.target_from_source;
-        assert!(d.translation().norm() < 1e-4 && d.theta().abs() < 1e-5, "{d:?}");
+        assert!(
+            d.translation().norm() < 1e-4 && d.theta().abs() < 1e-5,
+            "{d:?}"
+        );
         assert!(target.support(&source, &found.target_from_source, 0.01) > 0.99);
         assert!(found.mean_information.symmetric_eigenvalues().min() > 0.0);
         // Too few points: no target.
