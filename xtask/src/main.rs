@@ -98,7 +98,33 @@ enum DatasetsAction {
     },
 }
 
+/// The libraries' `log` records (their warnings) on standard error as `warning: …`: library
+/// crates never print themselves.
+struct LibraryLog;
+
+static LIBRARY_LOG: LibraryLog = LibraryLog;
+
+impl log::Log for LibraryLog {
+    fn enabled(&self, metadata: &log::Metadata<'_>) -> bool {
+        metadata.level() <= log::Level::Warn
+    }
+
+    fn log(&self, record: &log::Record<'_>) {
+        let level = if record.level() == log::Level::Error {
+            "error"
+        } else {
+            "warning"
+        };
+        eprintln!("{level}: {}", record.args());
+    }
+
+    fn flush(&self) {}
+}
+
 fn main() -> Result<()> {
+    if log::set_logger(&LIBRARY_LOG).is_ok() {
+        log::set_max_level(log::LevelFilter::Warn);
+    }
     let cli = Cli::parse();
     match cli.command {
         Command::Eval {
