@@ -14,6 +14,8 @@
 //!                                         error that does not name the file and place
 //! cargo xtask check-layers                no crate depends on a higher layer than its own
 //!                                         (layers from docs/architecture.md)
+//! cargo xtask readme                      rewrite README.md's headline table from the
+//!                                         results pages
 //! ```
 
 mod datasets;
@@ -71,6 +73,9 @@ enum Command {
     /// Check that no crate depends on a crate of a higher layer (layers from the crate table
     /// of docs/architecture.md, dependencies from `cargo metadata`); every crate must be listed.
     CheckLayers,
+    /// Rewrite README.md's headline table from the `**Headline.**` lines of the results pages
+    /// (what a full evaluation run does for its own page).
+    Readme,
     /// One workload of `eval memory` in a process of its own (prints one JSON line).
     #[command(hide = true)]
     MemoryProbe {
@@ -98,7 +103,33 @@ enum DatasetsAction {
     },
 }
 
+/// The libraries' `log` records (their warnings) on standard error as `warning: …`: library
+/// crates never print themselves.
+struct LibraryLog;
+
+static LIBRARY_LOG: LibraryLog = LibraryLog;
+
+impl log::Log for LibraryLog {
+    fn enabled(&self, metadata: &log::Metadata<'_>) -> bool {
+        metadata.level() <= log::Level::Warn
+    }
+
+    fn log(&self, record: &log::Record<'_>) {
+        let level = if record.level() == log::Level::Error {
+            "error"
+        } else {
+            "warning"
+        };
+        eprintln!("{level}: {}", record.args());
+    }
+
+    fn flush(&self) {}
+}
+
 fn main() -> Result<()> {
+    if log::set_logger(&LIBRARY_LOG).is_ok() {
+        log::set_max_level(log::LevelFilter::Warn);
+    }
     let cli = Cli::parse();
     match cli.command {
         Command::Eval {
@@ -123,6 +154,9 @@ fn main() -> Result<()> {
         Command::MemoryProbe { workload, quick } => eval::memory::probe(&workload, quick),
         Command::CheckLayers => {
             layers::run(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        }
+        Command::Readme => {
+            readme::update(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
         }
     }
 }

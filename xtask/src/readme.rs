@@ -1,8 +1,9 @@
-//! The README's crate map quotes each evaluation's headline between the markers
-//! `<!-- headline:NAME -->` and `<!-- /headline -->`. A full `cargo xtask eval NAME` writes
-//! the headline into `docs/results/NAME.md` (the line starting `**Headline.**`) and the same
-//! text between the README's markers, so no figure there is typed by hand; a test checks that
-//! every marked README text equals its results page.
+//! The README's headline table: one row per evaluation whose full-run results page has a
+//! headline (the line starting `**Headline.**` that a full `cargo xtask eval NAME` writes into
+//! `docs/results/NAME.md`), with the headline and a link to the page. The table sits between
+//! the README's markers `<!-- headlines -->` and `<!-- /headlines -->`; a full run rewrites it
+//! from the results pages, so no figure there is typed by hand, and a test checks that the
+//! README's table equals the one the pages give.
 
 use std::path::Path;
 
@@ -11,29 +12,62 @@ use anyhow::{Context, Result};
 /// The line prefix of the headline on a results page of a full run.
 pub const PREFIX: &str = "**Headline.** ";
 
-fn markers(name: &str) -> (String, &'static str) {
-    (format!("<!-- headline:{name} -->"), "<!-- /headline -->")
+const OPEN: &str = "<!-- headlines -->";
+const CLOSE: &str = "<!-- /headlines -->";
+
+/// The headline of a results page (`None` without one, or on a quick run's page).
+pub fn headline_of(results_md: &str) -> Option<&str> {
+    results_md
+        .lines()
+        .find_map(|line| line.strip_prefix(PREFIX))
 }
 
-/// `readme` with the text between `name`'s markers replaced by `text`; `None` when the README
-/// has no markers for `name`.
-pub fn replace(readme: &str, name: &str, text: &str) -> Option<String> {
-    let (open, close) = markers(name);
-    let start = readme.find(&open)? + open.len();
-    let end = start + readme[start..].find(close)?;
-    Some(format!("{}{text}{}", &readme[..start], &readme[end..]))
+/// The headline table of `(evaluation, its results page)`, in the order given; evaluations
+/// whose page has no full-run headline get no row.
+pub fn table<'a>(pages: impl IntoIterator<Item = (&'a str, &'a str)>) -> String {
+    let mut out = String::from("| Evaluation | Headline (last full run) |\n| --- | --- |\n");
+    for (name, page) in pages {
+        if let Some(headline) = headline_of(page) {
+            out.push_str(&format!(
+                "| [{name}](docs/results/{name}.md) | {} |\n",
+                headline.replace('|', "\\|")
+            ));
+        }
+    }
+    out
 }
 
-/// Writes `text` between `name`'s markers in `root/README.md` (nothing when it has none).
-pub fn update(root: &Path, name: &str, text: &str) -> Result<()> {
+/// The headline table of the results pages under `root/docs/results/` (missing pages give no
+/// row), in the order `cargo xtask eval all` runs the evaluations.
+pub fn table_of(root: &Path) -> String {
+    let pages: Vec<(&str, String)> = crate::eval::names()
+        .map(|name| {
+            let path = root.join(format!("docs/results/{name}.md"));
+            (name, std::fs::read_to_string(path).unwrap_or_default())
+        })
+        .collect();
+    table(pages.iter().map(|(name, page)| (*name, page.as_str())))
+}
+
+/// `readme` with the text between the headline markers replaced by `table` (a line break
+/// after the opening marker); `None` when the README has no markers.
+pub fn replace(readme: &str, table: &str) -> Option<String> {
+    let start = readme.find(OPEN)? + OPEN.len();
+    let end = start + readme[start..].find(CLOSE)?;
+    Some(format!("{}\n{table}{}", &readme[..start], &readme[end..]))
+}
+
+/// Rewrites the headline table of `root/README.md` from the results pages under `root`
+/// (nothing when the README has no markers or the table is unchanged).
+pub fn update(root: &Path) -> Result<()> {
     let path = root.join("README.md");
     let readme =
         std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    if let Some(updated) = replace(&readme, name, text)
+    if let Some(updated) = replace(&readme, &table_of(root))
         && updated != readme
     {
         std::fs::write(&path, updated).with_context(|| format!("writing {}", path.display()))?;
-        eprintln!("updated the {name} headline in {}", path.display());
+        eprintln!("updated the headline table in {}", path.display());
     }
     Ok(())
 }
@@ -43,65 +77,58 @@ pub fn update(root: &Path, name: &str, text: &str) -> Result<()> {
 mod tests {
     use super::*;
 
-    /// Every `(name, text)` between markers in `readme`.
-    fn marked(readme: &str) -> Vec<(String, String)> {
-        let mut out = Vec::new();
-        let mut rest = readme;
-        while let Some(i) = rest.find("<!-- headline:") {
-            let after = &rest[i + "<!-- headline:".len()..];
-            let Some(name_end) = after.find(" -->") else {
-                break;
-            };
-            let name = after[..name_end].to_owned();
-            let body = &after[name_end + " -->".len()..];
-            let Some(end) = body.find("<!-- /headline -->") else {
-                break;
-            };
-            out.push((name, body[..end].to_owned()));
-            rest = &body[end..];
-        }
-        out
-    }
-
-    /// The headline of a results page (`None` without one, or on a quick run's page).
-    fn headline_of(results_md: &str) -> Option<&str> {
-        results_md
-            .lines()
-            .find_map(|line| line.strip_prefix(PREFIX))
+    /// The text between the README's headline markers (`None` without them).
+    fn marked(readme: &str) -> Option<&str> {
+        let start = readme.find(OPEN)? + OPEN.len();
+        let end = start + readme[start..].find(CLOSE)?;
+        Some(
+            readme[start..end]
+                .strip_prefix('\n')
+                .unwrap_or(&readme[start..end]),
+        )
     }
 
     #[test]
-    fn replace_and_find_marked_text() {
-        let readme =
-            "a <!-- headline:x -->old<!-- /headline --> b <!-- headline:y -->z<!-- /headline -->";
-        let new = replace(readme, "x", "new 1.5 %").unwrap();
+    fn the_table_has_a_row_per_full_run_headline() {
+        let pages = [
+            ("a", "# A\n\n**Headline.** 1.5 % | 2 m\n\nbody"),
+            ("b", "# B\n\n**Headline (quick run).** 3 m\n"),
+            ("c", "# C\n\nno headline\n"),
+            ("d", "**Headline.** 4 s\n"),
+        ];
+        let t = table(pages);
         assert_eq!(
-            new,
-            "a <!-- headline:x -->new 1.5 %<!-- /headline --> b <!-- headline:y -->z<!-- /headline -->"
+            t,
+            "| Evaluation | Headline (last full run) |\n| --- | --- |\n\
+             | [a](docs/results/a.md) | 1.5 % \\| 2 m |\n\
+             | [d](docs/results/d.md) | 4 s |\n"
         );
-        assert_eq!(
-            marked(&new),
-            vec![("x".into(), "new 1.5 %".into()), ("y".into(), "z".into())]
-        );
-        assert!(replace(readme, "w", "t").is_none());
+        let readme = format!("x\n{OPEN}\nold\n{CLOSE}\ny");
+        let new = replace(&readme, &t).unwrap();
+        assert_eq!(new, format!("x\n{OPEN}\n{t}{CLOSE}\ny"));
+        assert_eq!(marked(&new), Some(t.as_str()));
+        assert_eq!(replace(&new, &t).as_deref(), Some(new.as_str()));
+        assert!(replace("no markers", &t).is_none());
         assert_eq!(headline_of("# T\n\n**Headline.** 3 m\n"), Some("3 m"));
         assert_eq!(headline_of("**Headline (quick run).** 3 m"), None);
     }
 
-    /// Every figure the README's crate map quotes is the headline of a full run's results page.
+    /// Every figure of the README's headline table is the headline of a full run's results
+    /// page, and every full-run headline has its row.
     #[test]
     fn readme_headlines_equal_the_results_pages() {
         let root = crate::eval::workspace_root();
         let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
-        for (name, text) in marked(&readme) {
-            let page = root.join(format!("docs/results/{name}.md"));
-            let md = std::fs::read_to_string(&page).unwrap();
-            assert_eq!(
-                headline_of(&md),
-                Some(text.as_str()),
-                "README headline of {name} differs from {} (run `cargo xtask eval {name}`)",
-                page.display()
-            );
-        }
+        let marked = marked(&readme).expect("README.md has no `<!-- headlines -->` table");
+        let expected = table_of(&root);
+        assert!(
+            expected.lines().count() > 2,
+            "no results page under docs/results/ has a full-run headline"
+        );
+        assert_eq!(
+            marked, expected,
+            "the README's headline table differs from the results pages (a full run of \
+             `cargo xtask eval NAME` rewrites it; a quick run's page has no headline)"
+        );
     }
 }

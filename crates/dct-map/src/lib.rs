@@ -96,7 +96,7 @@
 //! * **Ridge.** The thesis maximizes the bare likelihood. With fewer rays than coefficients
 //!   (its own 500-ray timing sets at 40 × 40) the Gram matrix has near-null directions, and
 //!   along them the rounding error of `aᵀ K a` let Newton's method "increase" the likelihood
-//!   without bound (to 7·10⁹ on the aces log). A ridge `−δ ‖a‖²` with
+//!   without bound (on the aces log of `cargo xtask eval dct`). A ridge `−δ ‖a‖²` with
 //!   `δ = 1e-10 · max K_ii` ([`FitProblem::set_ridge_factor`]) stops it; on 10⁴ rays it
 //!   changes the log-likelihood by well under one nat per thousand rays.
 //! * **Prior** ([`FitProblem::set_prior_path_density`], default [`PRIOR_PATH_DENSITY`]
@@ -105,15 +105,11 @@
 //!   where no mapping ray passes (behind walls, in patch corners, in gaps between scans —
 //!   the "random values" in unexplored areas of Sec. 3.3, the missing "unexplored areas" of
 //!   Sec. 9.6), and the ML fit parks huge rates there: on the CARMEN patches of `cargo xtask
-//!   eval dct` the 40 × 40 csail map reaches `λ = 2·10⁴ /m` in a 0.3 m hole that no
-//!   mapping ray enters or ends in, and the one held-back no-return ray crossing it gets
-//!   `ln p = −6517` (optical depth 6517; the grid: −13), which makes the held-back
-//!   difference DCT − grid −6372 for the whole log; belgioioso 40² (−100, worst ray −349)
-//!   and csail 29² (−37, worst ray −237) fail the same way, and aces 10² holds
-//!   `λ = 4·10⁷ /m` in a corner no ray reaches. It is not `λ → 0` (Eq. 9.6 squares `g`, so
-//!   `λ ≥ 0`; the worst held-back *hits* score −5 and −12 on those two maps), nor an early
-//!   stop (at a relative tolerance of 1e-7 instead of 1e-3 the fits take 7 iterations
-//!   instead of 4 and give the same −6371 and −101). The numerical ridge above is a prior
+//!   eval dct` the largest maps hold holes and corners that no mapping ray enters with rates
+//!   many orders of magnitude above the walls', and one held-back no-return ray crossing such
+//!   a hole can outweigh every other ray of the log. It is not `λ → 0` (Eq. 9.6 squares `g`,
+//!   so `λ ≥ 0`; the held-back *hits* on those maps score as usual), nor an early stop (a
+//!   much tighter relative tolerance gives the same maps). The numerical ridge above is a prior
 //!   of this kind, but `δ ≈ 2.5·10⁻⁶` there amounts to `ρ ≈ 10⁻⁷ /m`. The fix is a prior of
 //!   physical size:
 //!   the rate part `β` of the conjugate gamma prior on decay rates of Sec. 8.4.3 (Eq. 8.17,
@@ -123,17 +119,13 @@
 //!   rays. By Parseval it is a diagonal ridge on `a`, so a fit costs the same. (The shape
 //!   part `α` has no closed form for a continuous map and, with `α < 1` as Sec. 8.5's
 //!   moment matching gives on these logs, would reward `λ → 0`; it is not used.)
-//!   Measured on the 10 logs of `cargo xtask eval dct` (500 held-back rays): at 40² the
-//!   mean difference DCT − grid goes from −568.6 ± 2040.9 (8 of 10 above the grid) to
-//!   +109.6 ± 71.2 (10 of 10; csail −6371 → +118, belgioioso −100 → +209, worst log +6.6);
-//!   29² from 101.2 to 112.9 (10 of 10); at 10², 13², 20² the means move from 126.7, 123.0,
-//!   117.4 to 111.2, 110.5, 105.4, every log keeping its sign — the loss is almost all
-//!   aces (511 → 372 at 10²), whose ML maps gain on the held-back rays from rates of
-//!   10⁷ /m outside the data; RMSE of `p_ref` is unchanged to ±0.001 at every size.
-//!   `ρ = 0.1` still leaves csail 40² at −64 and 20 000 held-back rays on belgioioso 40²
-//!   find a ray at −866; `ρ = 1` and `ρ = 3` differ by a few nats; the empirical-Bayes `β` of
-//!   Sec. 8.5 (moment matching on the `L × M` grid), per cell area, varies 10⁴-fold between
-//!   logs and sizes (0.005–57 /m) and is lowest on aces, so a fixed density was chosen. `0` restores the thesis's plain ML fit.
+//!   On the logs of `cargo xtask eval dct` the prior lifts the largest DCT maps above the
+//!   grid on held-back rays, moves the smaller sizes little and leaves the RMSE of `p_ref`
+//!   as it was; the held-back figures of the default are in `docs/results/dct.md`. Much
+//!   weaker densities leave some of the holes; `ρ` around 1 /m is flat; the empirical-Bayes
+//!   `β` of Sec. 8.5 (moment matching on the `L × M` grid), per cell area, varies by orders
+//!   of magnitude between logs and sizes, so a fixed density was chosen. `0` restores the
+//!   thesis's plain ML fit.
 //! * **Solver.** Trust-region Newton (Levenberg–Marquardt damping on the exact Hessian, with
 //!   step doubling while the quadratic model is accurate) is the default: it reaches the
 //!   thesis's stopping rule in 4–6 iterations, while L-BFGS stops early under the same

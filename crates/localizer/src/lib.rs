@@ -105,21 +105,10 @@
 //! ## Performance
 //!
 //! `cargo bench -p raypath-localizer --bench filter` (criterion; synthetic model of 8 beacon
-//! ranges, odometry motion model, resampling every step; one core of the 2-core development
-//! machine):
-//!
-//! | state | particles | predict | update | resample | full step | steps/s |
-//! | --- | --- | --- | --- | --- | --- | --- |
-//! | SE(2) | 1000 | 54 µs | 34 µs | 14.5 µs | 109 µs | ≈ 9 200 |
-//! | SE(2) | 5000 | 270 µs | 165 µs | 71 µs | 550 – 590 µs | ≈ 1 750 |
-//! | SE(3) | 1000 | | | | 144 µs | ≈ 6 900 |
-//! | SE(3) | 5000 | | | | 710 – 760 µs | ≈ 1 350 |
-//!
-//! Per particle that is ≈ 54 ns to predict (random stream, three normal draws, two sin/cos),
-//! ≈ 33 ns to weight (most of it the 8 ranges) and ≈ 14 ns to resample, so 5000 particles
-//! at 50 Hz (the pole-landmark target) spend about 3 % of the 20 ms budget in the
-//! filter. Prediction and weighting scale with rayon (≈ 1.75× on 2 cores when the second
-//! core is free); normalization and resampling are O(N) and partly sequential.
+//! ranges, odometry motion model, resampling every step) times predict, update and resample
+//! for SE(2) and SE(3) at 1000 and 5000 particles. Prediction and weighting scale with rayon;
+//! normalization and resampling are O(N) and partly sequential. Filter speed on real maps is
+//! measured by `cargo xtask eval mcl`: `docs/results/mcl.md` has the figures.
 //!
 //! Units and frames: metres, radians, seconds; REP-103 (x forward, y left, z up). Poses are
 //! `world_from_robot`.

@@ -77,13 +77,11 @@
 //!
 //! ## Measured performance
 //!
-//! `cargo bench -p raypath-polylines` (criterion, one thread, 20 Intel scans of 180 beams,
-//! J = 20, Intel Xeon, shared 2-core machine): PLE 0.19 ms, PLE+ with Levenberg–Marquardt
-//! 0.30 ms, PLE+ with Nelder–Mead 0.56 ms per scan (thesis, MATLAB: 1.4 s and 2.3 s). On the
-//! full benchmark (`cargo xtask eval polylines`, `docs/results/polylines.md`) PLE+ has the
-//! lowest RMSE of all methods on simulated scans at every J and on real scans up to J = 40;
-//! Levenberg–Marquardt reaches a lower mean RMSE than Nelder–Mead at all J on simulated
-//! scans and equal within ±0.2 mm on real ones, 2–20 times faster — hence the default.
+//! `cargo bench -p raypath-polylines` times PLE and PLE+ (Levenberg–Marquardt and
+//! Nelder–Mead) per scan on 20 Intel scans; `cargo xtask eval polylines` compares every
+//! method's RMSE and speed on real and simulated scans, beside the thesis' figures:
+//! `docs/results/polylines.md` has the figures, including why Levenberg–Marquardt is the
+//! default optimizer.
 //!
 //! ## Decisions on the thesis' open points
 //!

@@ -36,23 +36,14 @@
 //! * Hector's node defaults kept: 3 levels, 3 iterations on coarse levels and 5 on the finest,
 //!   rotation steps clamped to 0.2 rad, map updates after 0.4 m or 0.9 rad.
 //!
-//! ## Results (`cargo xtask eval scan-matching`, docs/results/scan-matching.md)
+//! ## Results
 //!
-//! * Raw Intel / fr079 / mit-csail, occupancy residual with odometry as the initial guess:
-//!   relative-motion error 0.030 ± 0.025 m / 0.025 ± 0.019 m / 0.074 ± 0.149 m over
-//!   consecutive corrected-log scans (Kümmerle et al. 2009 scan-matching anchor on Intel:
-//!   0.22 ± 0.30 m). Without odometry (pure Hector) the default configuration diverges on Intel
-//!   and mit-csail.
-//! * Simulated calibration: the LUT removes the overlap of three surfaces' histograms
-//!   (≤ 0.01 vs 0.14–0.43 raw and 0.21–0.52 range-only).
-//! * Simulated failure case (8.5 × 5.5 m room, ±60°): occupancy-only ATE 3.9 m (fails),
-//!   reflectivity 0.048 m, combined 0.017 m.
-//! * Generated indoor world `lab` (360°, remissions, noisy odometry): without odometry the
-//!   combined residual (ATE 0.044 m) beats occupancy (0.21 m) and reflectivity alone (fails,
-//!   3.2 m); with the odometry guess occupancy is best (0.016 m; combined 0.037 m).
-//! * 3300–5600 scans/s on Intel (180 beams, map updates included, shared machine); aim ≥ 200.
-//! * Basin of convergence: about one coarsest cell (20 cm with 3 levels at 5 cm); on clean
-//!   synthetic scans the bilinear map leaves a bias of up to about half a finest cell.
+//! `cargo xtask eval scan-matching` measures the calibration and the matcher on the real
+//! benchmark logs (relative-motion error against the corrected logs), real KITTI and Ouster
+//! intensities, simulated failure cases and generated indoor worlds, with and without the
+//! odometry guess, and the matcher's speed: `docs/results/scan-matching.md` has the figures.
+//! The basin of convergence is about one coarsest cell; on clean synthetic scans the bilinear
+//! map leaves a bias of up to about half a finest cell.
 //!
 //! ## Example
 //!

@@ -136,49 +136,17 @@
 //!
 //! ## Performance
 //!
-//! Measured on the shared 2-core machine (other builds running; medians of criterion):
-//!
-//! Ray log-likelihoods, one thread (`cargo bench -p raypath-sensor-models --bench likelihood`,
-//! `RAYPATH_DATA` set: 2-D map of the corrected Intel log, 407 × 380 cells of 0.1 m, 4 000
-//! test rays; 3-D: 200 × 200 × 40 voxels of 0.5 m, 5 000 rays of 5–40 m):
-//!
-//! | model | 2-D exact [rays/s] | 2-D tabulated [rays/s] | 180-beam scans/s exact / tabulated | 3-D exact [rays/s] |
-//! |---|---|---|---|---|
-//! | decay-rate | 2.74 M | 2.93 M | 15 900 / 15 900 | 1.36 M |
-//! | decay-rate posterior | 1.24 M | ≈ 0.8 × decay-rate¹ | 7 900 / ≈ decay-rate¹ | 0.75 M |
-//! | reflection | 2.13 M | 2.59 M | 12 600 / 12 900 | 1.34 M |
-//! | reflection posterior | 2.10 M | 2.42 M | 12 600 / 13 500 | 1.35 M |
-//! | log-odds | 2.24 M | 2.30 M | 12 500 / 13 700 | 1.29 M |
-//! | likelihood field | 0.72 M | 2.69 M | 4 000 / 15 500 | 1.06 M |
-//!
-//! ¹ The posterior's table was added later and measured in a separate run on a heavily
-//! loaded machine, beside the ML decay-rate table in the same run: 437 K vs 555 K rays/s and
-//! 2 520 vs 2 410 scans/s (every figure of that run 4–6 × below the table above).
-//!
-//! On the Intel map the test rays are short (a few metres, some 40 cells), so the exact
-//! traversal is already cheap and the tables (360 directions, blended: four scattered
-//! look-ups in ~200 MB) gain little except for the likelihood field, whose per-ray
-//! normalizer is a second integral; the gain grows with ray length and with the spread of
-//! particle poses (the `mcl` evaluation measures whole filter updates). The Gamma posterior
-//! costs two logarithms per cell; its table counts every crossed cell at the mean chord of
-//! the direction (its miss exponent `a ln(1 + d/b)` is not linear in the length `d`, see
-//! [`Tabulated`]), exact for well-observed cells.
-//!
-//! Table accuracy on the same Intel map (`tests/real_carmen.rs`, scans at the true pose and
-//! up to 0.5 m / 0.15 rad away, 360 blended directions): relative error of the scan
-//! log-likelihood, median (p95), and how often two poses are ordered as by the exact model —
-//! decay-rate 0.8 % (22 %), 0.982; decay-rate posterior 0.6 % (23 %), 0.995; reflection
-//! 0.6 % (11 %), 0.986. Measured on the shared 2-core machine while other builds
-//! ran; treat the figures as lower bounds.
-//!
-//! Map building (`raypath map`, all cores): the corrected Intel log (163 800 beams, 0.1 m
-//! cells) at 1.7 M rays/s; the simulated KITTI-layout drive `urban-kitti` (128.5 M points,
-//! 0.5 m voxels, `--max-range 60`) at 3.0 M rays/s. The mapping bench
-//! (`cargo bench -p raypath-sensor-models --bench mapping`: 48 sweeps of 20 000 rays of
-//! 20–60 m, 400 × 400 × 40 voxels; 2 000 scans of 180 beams of 1–30 m on 0.1 m cells), on the
-//! otherwise idle 2-core machine (`-- --warm-up-time 1 --measurement-time 8`): 3-D dense
-//! 2.04 M rays/s on both cores (one thread 1.27 M), 3-D sparse 1.32 M; long rays cross
-//! ~100 voxels each, which is why the KITTI drive (mostly short ground returns) maps faster.
+//! `cargo bench -p raypath-sensor-models --bench likelihood` times ray log-likelihoods per
+//! model, exact and tabulated, in 2-D (with `RAYPATH_DATA`: the map of the corrected Intel
+//! log) and 3-D; `--bench mapping` times map building from dense and sparse statistics. The
+//! optical-depth tables answer a ray in O(1), so they gain most on long rays and for the
+//! likelihood field, whose per-ray normalizer is a second integral; on short indoor rays the
+//! exact traversal is already cheap. The Gamma posterior costs two logarithms per cell; its
+//! table counts every crossed cell at the mean chord of the direction (its miss exponent
+//! `a ln(1 + d/b)` is not linear in the length `d`, see [`Tabulated`]), exact for
+//! well-observed cells. `tests/real_carmen.rs` checks the tables against the exact models on
+//! the Intel map. Measured figures — scoring, inverse KL and the filter updates built on
+//! these models — are in `docs/results/sensor-models.md` and `docs/results/mcl.md`.
 
 mod dimension;
 pub mod edt;

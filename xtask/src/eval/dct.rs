@@ -12,7 +12,7 @@
 //! points sampled along the same mapping rays and scored on the held-back rays through a
 //! 0.05 m raster (Table 9.3's DCT − GPOM and DCT − HM columns; their fit times beside Table
 //! 9.4's t_GPOM and t_HM). As a control, the DCT map is also scored through that raster.
-//! The headline (real logs) goes to the README's crate map.
+//! The headline (real logs) goes to the README's headline table.
 //!
 //! In stages: one unit per log ([`measure`]), the page ([`report()`]) from their results.
 

@@ -44,7 +44,7 @@ pub struct EvalContext {
     pub quick: bool,
     /// Where the outputs go: `docs/results/`, `target/eval/` (and shards) under it. The
     /// workspace root, or `RAYPATH_EVAL_OUT` when set (tests and cluster runs that must not
-    /// write into the checkout; the README's generated figures are then left alone).
+    /// write into the checkout; the README's headline table is then left alone).
     pub out_dir: PathBuf,
 }
 
@@ -124,7 +124,7 @@ pub struct EvalReport {
     /// Machine-readable results.
     pub json: serde_json::Value,
     /// The run's figures in one line, real rows first (simulated ones named so): written at
-    /// the top of the results page and, after a full run, into the README's crate map
+    /// the top of the results page and, after a full run, into the README's headline table
     /// ([`crate::readme`]).
     pub headline: Option<String>,
 }
@@ -262,6 +262,11 @@ const EVALUATIONS: &[(&str, &str, Runner)] = &[
         Runner::Staged(&registration::STAGED),
     ),
 ];
+
+/// The names of all evaluations in the order `all` runs them.
+pub fn names() -> impl Iterator<Item = &'static str> {
+    EVALUATIONS.iter().map(|(name, _, _)| *name)
+}
 
 /// The evaluations written in stages: `--shard i/n` and `eval merge` work for these.
 fn staged_evaluations() -> impl Iterator<Item = &'static stages::Staged> {
@@ -407,12 +412,8 @@ fn write_report(ctx: &EvalContext, report: &EvalReport, seconds: f64) -> Result<
     std::fs::write(&json_path, serde_json::to_string_pretty(&json)?)
         .with_context(|| format!("writing {}", json_path.display()))?;
     eprintln!("wrote {} and {}", md_path.display(), json_path.display());
-    if let (Some(text), false, true) = (
-        &report.headline,
-        ctx.quick,
-        ctx.out_dir == ctx.workspace_root,
-    ) {
-        crate::readme::update(&ctx.workspace_root, report.name, text)?;
+    if report.headline.is_some() && !ctx.quick && ctx.out_dir == ctx.workspace_root {
+        crate::readme::update(&ctx.workspace_root)?;
     }
     Ok(())
 }

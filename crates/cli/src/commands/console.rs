@@ -13,11 +13,37 @@ static LEVEL: AtomicU8 = AtomicU8::new(1);
 /// The global `--json`.
 static JSON: AtomicBool = AtomicBool::new(false);
 
-/// Sets the global flags (once, in `main`).
+/// Sets the global flags (once, in `main`) and prints the libraries' warnings: the readers
+/// return them as values and emit them through the `log` facade, printed here as
+/// `warning: …` (silenced by `--quiet`).
 pub fn set(quiet: bool, verbose: u8, json: bool) {
     let level = if quiet { 0 } else { 1 + verbose.min(2) };
     LEVEL.store(level, Ordering::Relaxed);
     JSON.store(json, Ordering::Relaxed);
+    if log::set_logger(&LIBRARY_LOG).is_ok() {
+        log::set_max_level(log::LevelFilter::Warn);
+    }
+}
+
+/// The libraries' `log` records on standard error: warnings as [`warn`], errors as `error: …`.
+struct LibraryLog;
+
+static LIBRARY_LOG: LibraryLog = LibraryLog;
+
+impl log::Log for LibraryLog {
+    fn enabled(&self, metadata: &log::Metadata<'_>) -> bool {
+        metadata.level() <= log::Level::Warn
+    }
+
+    fn log(&self, record: &log::Record<'_>) {
+        match record.level() {
+            log::Level::Error => eprintln!("error: {}", record.args()),
+            log::Level::Warn => warn(record.args()),
+            _ => {}
+        }
+    }
+
+    fn flush(&self) {}
 }
 
 /// Whether `--json` was given: every subcommand then prints one JSON document on standard

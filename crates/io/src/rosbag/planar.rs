@@ -54,7 +54,7 @@ impl BagScans {
         let bag = BagFiles::resolve(path)?;
         let mut pass = first_pass(&bag, false)?;
         for w in &pass.warnings {
-            eprintln!("warning: {w}");
+            log::warn!("{w}");
         }
         let topic = pass
             .choose(
@@ -72,7 +72,7 @@ impl BagScans {
         if !poses.has_motion() {
             let note = "the bag has no odometry and no tf: the robot and laser poses are the \
                         identity";
-            eprintln!("warning: {}: {note}", path.display());
+            log::warn!("{}: {note}", path.display());
             poses.notes.push(note.into());
         }
         Ok(Self {
@@ -98,7 +98,8 @@ impl BagScans {
         &self.topic
     }
 
-    /// The warnings printed so far (truncation, messages out of order, tf conflicts).
+    /// The warnings met so far (truncation, messages out of order, tf conflicts, skipped
+    /// scans), also emitted through the `log` facade as they occur.
     pub fn warnings(&self) -> &[String] {
         &self.warnings
     }
@@ -112,7 +113,7 @@ impl BagScans {
         if let Some(reader) = self.reader.as_mut() {
             for w in reader.take_warnings() {
                 if self.known_warnings.insert(w.clone()) {
-                    eprintln!("warning: {w}");
+                    log::warn!("{w}");
                     self.warnings.push(w);
                 }
             }
@@ -221,7 +222,7 @@ impl BagScans {
                             self.topic,
                             log_time as f64 * 1e-9
                         );
-                        eprintln!("warning: {w}");
+                        log::warn!("{w}");
                         self.warnings.push(w);
                     }
                     continue;
@@ -246,13 +247,14 @@ impl BagScans {
             return Err(e);
         }
         if self.skipped > MAX_SKIP_WARNINGS {
-            eprintln!(
-                "warning: {}: {} scans of {} skipped in all (odometry or tf do not cover \
-                 their times)",
+            let w = format!(
+                "{}: {} scans of {} skipped in all (odometry or tf do not cover their times)",
                 self.name.display(),
                 self.skipped,
                 self.topic
             );
+            log::warn!("{w}");
+            self.warnings.push(w);
         }
         Ok(None)
     }
@@ -278,5 +280,9 @@ impl Iterator for BagScans {
 impl PlanarSource for BagScans {
     fn name(&self) -> &Path {
         &self.name
+    }
+
+    fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 }

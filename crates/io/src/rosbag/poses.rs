@@ -80,7 +80,7 @@ impl Poses {
 
     fn note(&mut self, note: String) {
         if !self.notes.contains(&note) {
-            eprintln!("warning: {note}");
+            log::warn!("{note}");
             self.notes.push(note);
         }
     }

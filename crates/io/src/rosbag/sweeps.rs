@@ -87,7 +87,7 @@ pub fn open_sweeps(path: &Path, topics: &Topics) -> Result<SweepSequence> {
     let bag = BagFiles::resolve(path)?;
     let mut pass = first_pass(&bag, true)?;
     for w in &pass.warnings {
-        eprintln!("warning: {w}");
+        log::warn!("{w}");
     }
     let topic = pass
         .choose(
@@ -112,8 +112,8 @@ pub fn open_sweeps(path: &Path, topics: &Topics) -> Result<SweepSequence> {
     let mut skip = |r: &CloudRef, reason: &str| {
         skipped += 1;
         if skipped <= MAX_SKIP_WARNINGS {
-            eprintln!(
-                "warning: {}: {topic} at log time {:.9} s skipped: {reason}",
+            log::warn!(
+                "{}: {topic} at log time {:.9} s skipped: {reason}",
                 path.display(),
                 r.log_time as f64 * 1e-9
             );
@@ -139,16 +139,16 @@ pub fn open_sweeps(path: &Path, topics: &Topics) -> Result<SweepSequence> {
         kept.push(r);
     }
     if skipped > MAX_SKIP_WARNINGS {
-        eprintln!(
-            "warning: {}: {skipped} clouds of {topic} skipped in all",
+        log::warn!(
+            "{}: {skipped} clouds of {topic} skipped in all",
             path.display()
         );
     }
     let odometry: Option<Vec<Pose3>> = odometry.into_iter().collect();
     let covered = reference.iter().filter(|p| p.is_some()).count();
     if covered > 0 && covered < reference.len() {
-        eprintln!(
-            "warning: {}: the reference poses cover {covered} of {} clouds; they are not used",
+        log::warn!(
+            "{}: the reference poses cover {covered} of {} clouds; they are not used",
             path.display(),
             reference.len()
         );

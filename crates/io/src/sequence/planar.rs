@@ -117,6 +117,13 @@ impl PlanarFrame {
 pub trait PlanarSource: Iterator<Item = Result<PlanarFrame>> + Send {
     /// The file (and topic) the frames come from, for messages.
     fn name(&self) -> &Path;
+
+    /// The warnings met so far (lines or messages skipped, truncation, missing poses): the
+    /// reader does not print them; each is also emitted through the `log` facade as it
+    /// occurs, which the `raypath` program and `cargo xtask` print as `warning: …`.
+    fn warnings(&self) -> &[String] {
+        &[]
+    }
 }
 
 /// How to open a planar sequence.
@@ -139,6 +146,7 @@ pub struct CarmenScans {
     robot_lasers: Vec<LaserMessage>,
     seen_flaser: bool,
     drained: std::vec::IntoIter<LaserMessage>,
+    warnings: Vec<String>,
 }
 
 impl CarmenScans {
@@ -157,6 +165,7 @@ impl CarmenScans {
             robot_lasers: Vec::new(),
             seen_flaser: false,
             drained: Vec::new().into_iter(),
+            warnings: Vec::new(),
         }
     }
 
@@ -192,7 +201,8 @@ impl Iterator for CarmenScans {
             let reader = self.reader.as_mut()?;
             let record = reader.next();
             for warning in reader.take_warnings() {
-                eprintln!("warning: {warning}");
+                log::warn!("{warning}");
+                self.warnings.push(warning);
             }
             match record {
                 Some(Ok(Record::Laser(m))) => {
@@ -216,6 +226,10 @@ impl Iterator for CarmenScans {
 impl PlanarSource for CarmenScans {
     fn name(&self) -> &Path {
         &self.name
+    }
+
+    fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 }
 

@@ -70,26 +70,13 @@
 //!
 //! ## Performance
 //!
-//! `RAYPATH_DATA=… cargo bench -p raypath-localizer --bench mcl -- --warm-up-time 1
-//! --measurement-time 5` (criterion medians; one full update = predict + weight + resample,
-//! 1000 particles × 180 beams with `LidarConfig::default()` including the random-measurement
-//! mixture, map of the Intel Research Lab at 0.1 m from the corrected log, both cores of the
-//! otherwise idle 2-core machine):
-//!
-//! | model | time per update | updates/s | aim |
-//! | --- | --- | --- | --- |
-//! | likelihood field (AMCL, unnormalized) | 4.70 ms | ≈ 213 | ≥ 200 |
-//! | decay-rate, exact traversal | 25.9 ms | ≈ 39 | ≥ 20 |
-//! | decay-rate, optical-depth table | 21.5 ms | ≈ 47 | ≥ 20 |
-//! | reflection, optical-depth table | 26.2 ms | ≈ 38 | ≥ 20 |
-//!
-//! The mixture costs a logarithm and an exponential per beam, which narrows the gap between
-//! the table and the exact traversal (before the mixture, under load: 16.1 ms table vs
-//! 43.0 ms exact).
-//! On the synthetic 30 m × 20 m floor (no data): 4.36 ms, 76.5 ms, 29.3 ms and 36.2 ms
-//! (exact traversal pays for the longer rays there). The table answers a ray in O(1) but
-//! with two bilinear look-ups per end in two directions, so it gains 2.5–3× over the exact
-//! traversal on indoor maps with short rays.
+//! `RAYPATH_DATA=… cargo bench -p raypath-localizer --bench mcl` times one full update
+//! (predict + weight + resample, 1000 particles × 180 beams with `LidarConfig::default()`
+//! including the random-measurement mixture) per sensor model on the map of the Intel Research
+//! Lab; the `mcl` evaluation measures whole filter runs (`docs/results/mcl.md`). The mixture
+//! costs a logarithm and an exponential per beam. The optical-depth table answers a ray in
+//! O(1) but with two bilinear look-ups per end in two directions, so it gains over the exact
+//! traversal where rays are long and loses little where they are short.
 //!
 //! Frames: poses are `world_from_robot`; `robot_from_sensor` is the sensor mounting;
 //! rays in [`SpatialScan`] are in the sensor frame. Metres, radians (REP-103).
