@@ -54,11 +54,11 @@ impl Polyline {
 ///
 /// `ranges`, `angles`: `(B,)` float arrays, B ≥ 2; the angles evenly spaced and increasing
 /// (radians). Ranges at or above `max_range` (default: infinity) and infinite ranges are
-/// no-returns; NaN is refused. `max_vertices`: `J_max`. `method`: `"ple"` (default),
+/// no-returns; NaN is refused. `max_vertices`: `J_max` (20, as `raypath polylines`). `method`: `"ple"` (default),
 /// `"ple+"` (vertex optimization), or the baselines `"vvl"`, `"ief"`, `"sam"`. `max_edge`:
 /// `l_max`, metres. Returns the polylines, in the scan frame.
 #[pyfunction]
-#[pyo3(signature = (ranges, angles, max_vertices = 10, method = "ple", max_edge = 1.0, max_range = None))]
+#[pyo3(signature = (ranges, angles, max_vertices = 20, method = "ple", max_edge = 1.0, max_range = None))]
 pub fn ple(
     py: Python<'_>,
     ranges: &Bound<'_, PyAny>,
