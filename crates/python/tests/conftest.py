@@ -21,6 +21,8 @@ def data():
     """`RAYPATH_DATA` as a path; the test skips, saying why, when it is not set."""
     d = data_dir()
     if d is None or not d.is_dir():
+        if os.environ.get("RAYPATH_REQUIRE_DATA"):
+            pytest.fail(f"RAYPATH_REQUIRE_DATA is set but RAYPATH_DATA ({d}) is not a folder")
         pytest.skip("RAYPATH_DATA is not set: real-data test skipped")
     return d
 
@@ -35,9 +37,13 @@ def need(path):
 @pytest.fixture(scope="session")
 def cli():
     """Runs the `raypath` program (`RAYPATH_CLI`, else target/release/raypath) with `--json`
-    and returns the parsed document; skips when the program is not built."""
-    exe = pathlib.Path(os.environ.get("RAYPATH_CLI", REPO / "target" / "release" / "raypath"))
+    and returns the parsed document; skips when the default program is not built (fails when
+    `RAYPATH_CLI` names a missing one)."""
+    named = os.environ.get("RAYPATH_CLI")
+    exe = pathlib.Path(named) if named else REPO / "target" / "release" / "raypath"
     if not exe.is_file():
+        if named:
+            pytest.fail(f"RAYPATH_CLI={named} does not exist")
         pytest.skip(f"{exe} is not built (cargo build --release -p raypath-cli)")
 
     def run(*args):
