@@ -15,6 +15,7 @@ mod arrays;
 mod errors;
 mod io;
 mod octree;
+pub mod pipeline;
 mod place;
 mod planes;
 mod poles;

@@ -32,7 +32,7 @@ impl OccupancyTree {
             ));
         }
         if let Some(r) = max_range
-            && !(r > 0.0)
+            && (r.is_nan() || r <= 0.0)
         {
             return Err(value_error(
                 "max_range",

@@ -8,19 +8,15 @@ use std::time::Instant;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use raypath_geometry::{Aabb2, Grid2, Pose2, Scan2};
-use raypath_io::sequence::PlanarFrame;
-use raypath_sensor_models::export::{MapPicture, RosMapOptions, picture_values, write_ros_map};
-use raypath_sensor_models::{DenseStats2, MappingConfig};
+use raypath_geometry::{Grid2, Pose2};
+use raypath_sensor_models::export::{RosMapOptions, write_ros_map};
 use raypath_slam::benchmark::{file_relation_errors, match_relation_file};
 use raypath_slam::{Slam, SlamConfig};
 
 use crate::arrays::{matrix, poses2, vec1};
 use crate::errors::{input_error, io_error, value_error};
 use crate::io::{PlanarLog, read_planar};
-
-/// Largest map the rebuild allocates, cells.
-const MAX_CELLS: usize = 200_000_000;
+use crate::pipeline::rebuild_map;
 
 /// Scans processed between two progress calls (and checks for Ctrl-C).
 const PROGRESS_EVERY: usize = 100;
@@ -70,7 +66,7 @@ impl OccupancyMap {
     /// both paths.
     fn save(&self, path: PathBuf) -> PyResult<(String, String)> {
         let (pgm, yaml) = write_ros_map(&path, &self.grid, &self.values, &RosMapOptions::default())
-            .map_err(|e| input_error(e))?;
+            .map_err(input_error)?;
         Ok((pgm.display().to_string(), yaml.display().to_string()))
     }
 
@@ -294,41 +290,4 @@ pub fn slam(
         seconds,
         map: Py::new(py, OccupancyMap { grid, values })?,
     })
-}
-
-/// The reflection map of `frames` at `poses`: a grid covering the poses and the returns
-/// below `max_range`, no-returns not traced (as `raypath slam` rebuilds its map).
-fn rebuild_map(
-    frames: &[PlanarFrame],
-    poses: &[Pose2],
-    resolution: f64,
-    max_range: f64,
-) -> Result<(Grid2, Vec<Option<f64>>), String> {
-    let mut bounds = Aabb2::empty();
-    let mut scans: Vec<(Pose2, &Scan2)> = Vec::with_capacity(frames.len());
-    for (frame, pose) in frames.iter().zip(poses) {
-        if !pose.is_finite() {
-            continue;
-        }
-        bounds.extend(&nalgebra::Point2::new(pose.x(), pose.y()));
-        for ray in frame.scan.rays(*pose) {
-            if let Some(t) = ray.range.hit().filter(|&t| t < max_range) {
-                bounds.extend(&ray.at(t));
-            }
-        }
-        scans.push((*pose, &frame.scan));
-    }
-    let grid = Grid2::covering(&bounds, resolution).map_err(|e| e.to_string())?;
-    let [w, h] = grid.dims();
-    if w.saturating_mul(h) > MAX_CELLS {
-        return Err(format!(
-            "the map would have {w} × {h} cells of {resolution} m (at most {MAX_CELLS})"
-        ));
-    }
-    let mut config = MappingConfig::with_range(0.0, max_range).map_err(|e| e.to_string())?;
-    config.include_no_returns = false;
-    let mut stats = DenseStats2::planar(grid);
-    stats.insert_scans_par(&scans, &config);
-    let values = picture_values(&stats, MapPicture::Reflection);
-    Ok((grid, values))
 }
