@@ -33,6 +33,10 @@ const LAYERS: [&str; 6] = [
 /// The crates that may print: the program and the developer tool.
 const PRINTING_CRATES: [&str; 2] = ["raypath-cli", "xtask"];
 
+/// The crates that face users and are no library other crates build on: the program, the
+/// developer tool and the Python package (which prints nothing).
+const APPLICATIONS: [&str; 3] = ["raypath-cli", "xtask", "raypath-python"];
+
 /// The printing macros a library crate may not call.
 const PRINT_MACROS: [&str; 5] = ["println", "eprintln", "print", "eprint", "dbg"];
 
@@ -207,7 +211,8 @@ pub fn package_dirs(metadata: &serde_json::Value) -> Vec<(String, std::path::Pat
 pub enum Drawn {
     /// Exactly these workspace crates.
     Crates(Vec<String>),
-    /// Every workspace crate but [`PRINTING_CRATES`] (the program and the tool).
+    /// Every workspace crate but the [`APPLICATIONS`] (the program, the tool, the Python
+    /// package).
     EveryLibrary,
 }
 
@@ -259,7 +264,7 @@ pub fn graph_violations(
     let libraries: Vec<String> = deps
         .iter()
         .map(|(n, _)| n.clone())
-        .filter(|n| !PRINTING_CRATES.contains(&n.as_str()))
+        .filter(|n| !APPLICATIONS.contains(&n.as_str()))
         .collect();
     let mut out = Vec::new();
     for (name, uses) in deps {

@@ -236,6 +236,24 @@ const SUPPORTED: &str = "raypath reads CARMEN logs (.log/.clf[.gz|.bz2]), PCD, O
     x y z text, KITTI and NCLT directories and files, SegComp range and ground-truth files, \
     point CSVs with an x,y header, and Ouster pcap captures with their metadata JSON";
 
+/// Reads a file that holds one point cloud: a KITTI velodyne `.bin`, a PCD file or an `x y z`
+/// text file (what `raypath register` and the Python package's `raypath.open` read as a single
+/// scan). Any other format is an [`Error::UnknownFormat`] that names it and says what is read.
+pub fn read_cloud(path: &Path) -> Result<raypath_geometry::PointCloud> {
+    match Format::detect(path)? {
+        Format::KittiVelodyne => kitti::read_velodyne(path),
+        Format::Pcd => Ok(pcd::read_pcd(path, &Default::default())?.cloud),
+        Format::Xyz => xyz::read_xyz(path),
+        other => Err(Error::UnknownFormat {
+            path: path.to_path_buf(),
+            reason: format!(
+                "a {} is not a single scan; give a KITTI .bin, a PCD file or an x y z list",
+                other.name()
+            ),
+        }),
+    }
+}
+
 /// Summarizes a file or directory of any supported format (what `raypath info` prints).
 pub fn summarize(path: &Path) -> Result<Summary> {
     let format = Format::detect(path)?;

@@ -80,6 +80,6 @@ pub mod source;
 pub mod tum;
 pub mod xyz;
 
-pub use detect::{Format, summarize, summarize_as};
+pub use detect::{Format, read_cloud, summarize, summarize_as};
 pub use error::{Error, Location, Result};
 pub use summary::{BoundingBox, Summary, TimeSpan};

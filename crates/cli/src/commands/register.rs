@@ -35,7 +35,6 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use raypath_geometry::{PointCloud, Pose3};
-use raypath_io::Format;
 use raypath_registration::{
     Kernel, Odometry, OdometryConfig, Registration, RegistrationConfig, register,
 };
@@ -104,22 +103,14 @@ fn config(args: &Args) -> Result<RegistrationConfig, Failure> {
     Ok(config)
 }
 
-/// One scan file in its sensor frame.
+/// One scan file in its sensor frame ([`raypath_io::read_cloud`]).
 fn read_scan(path: &Path) -> Result<PointCloud, Failure> {
-    let bad = |e: raypath_io::Error| Failure::input(e);
-    match Format::detect(path).map_err(bad)? {
-        Format::KittiVelodyne => raypath_io::kitti::read_velodyne(path).map_err(bad),
-        Format::Pcd => Ok(raypath_io::pcd::read_pcd(path, &Default::default())
-            .map_err(bad)?
-            .cloud),
-        Format::Xyz => raypath_io::xyz::read_xyz(path).map_err(bad),
-        other => Err(Failure::input(format!(
-            "{}: a {} is not a single scan; give a KITTI .bin, a PCD file or an x y z \
-                 list (or a sequence alone)",
-            path.display(),
-            other.name()
-        ))),
-    }
+    raypath_io::read_cloud(path).map_err(|e| match e {
+        raypath_io::Error::UnknownFormat { .. } => {
+            Failure::input(format!("{e} (or a sequence alone)"))
+        }
+        other => Failure::input(other),
+    })
 }
 
 fn pose_json(pose: &Pose3) -> Value {

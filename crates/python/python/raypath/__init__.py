@@ -1,0 +1,47 @@
+"""raypath: lidar mapping, localization, place recognition and SLAM on NumPy arrays.
+
+>>> import raypath
+>>> log = raypath.open("intel.clf.bz2")          # doctest: +SKIP
+>>> res = raypath.slam(log)                       # doctest: +SKIP
+>>> res.map.save("intel.pgm")                     # doctest: +SKIP
+
+Submodules: :mod:`raypath.poles`, :mod:`raypath.planes`, :mod:`raypath.polylines`,
+:mod:`raypath.place_recognition`.
+"""
+
+from ._raypath import (
+    Cloud,
+    FormatError,
+    InputError,
+    OccupancyMap,
+    OccupancyTree,
+    PlanarLog,
+    RaypathError,
+    Scan,
+    SlamResult,
+    SweepLog,
+    __version__,
+    open,
+    slam,
+)
+from . import place_recognition, planes, poles, polylines
+
+__all__ = [
+    "Cloud",
+    "FormatError",
+    "InputError",
+    "OccupancyMap",
+    "OccupancyTree",
+    "PlanarLog",
+    "RaypathError",
+    "Scan",
+    "SlamResult",
+    "SweepLog",
+    "__version__",
+    "open",
+    "place_recognition",
+    "planes",
+    "poles",
+    "polylines",
+    "slam",
+]
