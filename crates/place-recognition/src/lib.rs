@@ -129,6 +129,7 @@ mod ibuild;
 // Image features and planar-scan images.
 mod features;
 mod raster;
+mod shape;
 
 // Baselines: DBoW2-style vocabulary tree, Scan Context, planar polar descriptor.
 mod dbow;
@@ -168,6 +169,9 @@ pub use verify::{Checked, GeometricCheck, GeometricCheckConfig, ScanMatch};
 pub use features::{FeatureConfig, Keypoint, detect_and_describe};
 pub use polar::{KEY_DIM as POLAR_KEY_DIM, PolarConfig, PolarContext, PolarDescription};
 pub use raster::{RasterConfig, rasterize_scan};
+pub use shape::{
+    RINGS as SHAPE_RINGS, SECTORS as SHAPE_SECTORS, ScanShapeConfig, scan_shape_descriptors,
+};
 // --- end features ---
 
 // --- lidar images (lidar-images work) ---
@@ -185,8 +189,8 @@ pub use rectilinear::{RectilinearConfig, cubic_front_back, rectilinear};
 
 // --- ibuild (IBuILD work) ---
 pub use ibuild::{
-    Ibuild, IbuildConfig, IbuildDescription, IbuildScore, MultiIndexLayout, StageTimes, Vocabulary,
-    VocabularySearch, WordIndex, match_consecutive, merge_descriptors,
+    Ibuild, IbuildConfig, IbuildDescription, IbuildScore, MultiIndexLayout, PlanarDescriptors,
+    StageTimes, Vocabulary, VocabularySearch, WordIndex, match_consecutive, merge_descriptors,
 };
 // --- end ibuild ---
 

@@ -1,7 +1,7 @@
 //! Parameters of IBuILD (Khan 2017, §4.4, §4.6.1).
 
 use super::search::VocabularySearch;
-use crate::{FeatureConfig, ImageConfig, PlaceError, Result};
+use crate::{FeatureConfig, ImageConfig, PlaceError, Result, ScanShapeConfig};
 
 /// Parameters of [`Ibuild`](super::Ibuild).
 #[derive(Clone, Debug, PartialEq)]
@@ -16,6 +16,9 @@ pub struct IbuildConfig {
     pub beta: usize,
     /// How frames become images.
     pub image: ImageConfig,
+    /// How planar scans are described: as images (the thesis' route, default) or by binary
+    /// shape descriptors made on the scan.
+    pub planar: PlanarDescriptors,
     /// Keypoints and descriptors.
     pub features: FeatureConfig,
     /// Require consecutive-frame matches to be mutual nearest neighbours (ours; default false,
@@ -43,6 +46,7 @@ impl Default for IbuildConfig {
             delta: 80,
             beta: 10,
             image: ImageConfig::default(),
+            planar: PlanarDescriptors::default(),
             features: FeatureConfig::default(),
             mutual_matching: false,
             merge_until_fixed_point: false,
@@ -52,6 +56,17 @@ impl Default for IbuildConfig {
             search: VocabularySearch::default(),
         }
     }
+}
+
+/// How [`Ibuild`](super::Ibuild) describes a planar scan.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum PlanarDescriptors {
+    /// Rasterise the scan ([`ImageConfig`]) and describe the picture with FAST/BRIEF, as every
+    /// other frame (default: the thesis describes images only, §4.4).
+    #[default]
+    Image,
+    /// Binary shape descriptors made on the scan ([`crate::scan_shape_descriptors`]; ours).
+    Shape(ScanShapeConfig),
 }
 
 /// Which similarity IBuILD reports for its hypotheses.
@@ -84,6 +99,9 @@ impl IbuildConfig {
                 name: "beta",
                 reason: "must be at least 1 frame (β > 0, §4.4.3)".into(),
             });
+        }
+        if let PlanarDescriptors::Shape(shape) = &self.planar {
+            shape.validate()?;
         }
         Ok(())
     }

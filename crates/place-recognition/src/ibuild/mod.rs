@@ -76,7 +76,7 @@ mod tests;
 use std::borrow::Cow;
 use std::time::Instant;
 
-pub use config::{IbuildConfig, IbuildScore};
+pub use config::{IbuildConfig, IbuildScore, PlanarDescriptors};
 pub use matching::{match_consecutive, merge_descriptors};
 pub use multi_index::MultiIndexLayout;
 pub use search::{VocabularySearch, WordIndex};
@@ -204,8 +204,15 @@ impl PlaceRecognizer for Ibuild {
 
     fn describe(&mut self, frame: &Frame<'_>) -> Result<IbuildDescription> {
         let start = Instant::now();
-        let image = crate::frame_image(frame, &self.config.image)?;
-        let (_, raw) = crate::detect_and_describe(&image, &self.config.features)?;
+        let raw = match (frame, &self.config.planar) {
+            (Frame::Planar(scan), PlanarDescriptors::Shape(shape)) => {
+                crate::scan_shape_descriptors(scan, shape)?
+            }
+            _ => {
+                let image = crate::frame_image(frame, &self.config.image)?;
+                crate::detect_and_describe(&image, &self.config.features)?.1
+            }
+        };
         self.clock.lap(Stage::Features, start);
         Ok(self.describe_descriptors(raw))
     }

@@ -8,9 +8,9 @@ use image::GrayImage;
 use raypath_place_recognition::{
     BinaryVocabulary, Bits512, Checked, Dbow, DbowConfig, FeatureConfig, GeometricCheck,
     GeometricCheckConfig, GistConfig, GlobalDescriptorDb, HogConfig, Ibuild, IbuildConfig,
-    IbuildScore, ImageConfig, PlaceError, PolarConfig, PolarContext, ScanContext,
-    ScanContextConfig, Shot3dBow, Shot3dBowConfig, ShotConfig, VocabularyConfig,
-    detect_and_describe,
+    IbuildScore, ImageConfig, PlaceError, PlanarDescriptors, PolarConfig, PolarContext,
+    ScanContext, ScanContextConfig, ScanShapeConfig, Shot3dBow, Shot3dBowConfig, ShotConfig,
+    VocabularyConfig, detect_and_describe,
 };
 
 use super::runner::{Features, Input, Runner, Sample, boxed, boxed_features, features_of};
@@ -256,8 +256,46 @@ fn planar_scan<'a>(
     }
 }
 
-/// The methods of the real 2-D logs: IBuILD and DBoW2-style on rasterised scans, planar
-/// polar context; each also with the geometric check.
+/// IBuILD's matching threshold δ on binary shape descriptors made on the scan (bits; ours):
+/// chosen on intel and freiburg-079 with the `shape_sweep` example of
+/// raypath-place-recognition and fixed for every log.
+pub const SHAPE_DELTA: u32 = 35;
+/// The δ sweep of the symmetric IBuILD on scan shapes (bits).
+pub const SHAPE_DELTAS: [u32; 6] = [20, 25, 30, 35, 40, 50];
+/// The label of IBuILD (printed score) on scan shapes.
+pub const SHAPE_IBUILD: &str = "IBuILD on scan shapes (ours)";
+/// The label of IBuILD (symmetric score) on scan shapes.
+pub const SHAPE_SYMMETRIC: &str = "Symmetric IBuILD on scan shapes (ours)";
+
+/// IBuILD on binary shape descriptors made on the planar scan (`PlanarDescriptors::Shape`,
+/// default settings), printed or symmetric score, with or without the geometric check.
+/// Labelled with " δ=NN" when `delta` is not [`SHAPE_DELTA`].
+pub fn ibuild_shape(score: IbuildScore, delta: u32, checked: bool) -> Result<Box<dyn Runner>> {
+    let config = IbuildConfig {
+        delta,
+        score,
+        planar: PlanarDescriptors::Shape(ScanShapeConfig::default()),
+        ..IbuildConfig::default()
+    };
+    let mut label = match score {
+        IbuildScore::Printed => SHAPE_IBUILD,
+        IbuildScore::Symmetric => SHAPE_SYMMETRIC,
+    }
+    .to_string();
+    if delta != SHAPE_DELTA {
+        label += &format!(" δ={delta}");
+    }
+    let ibuild = Ibuild::new(config)?;
+    Ok(if checked {
+        let check = GeometricCheck::new(ibuild, check_config())?;
+        boxed(check, label + CHECKED, Input::Planar)
+    } else {
+        boxed(ibuild, label, Input::Planar)
+    })
+}
+
+/// The methods of the real 2-D logs: IBuILD and DBoW2-style on rasterised scans, IBuILD on
+/// scan shapes, planar polar context; each also with the geometric check; the δ sweeps.
 pub fn planar(vocabulary: Option<&Arc<BinaryVocabulary>>) -> Result<Vec<Box<dyn Runner>>> {
     let mut out = vec![
         ibuild(Input::Planar, DEFAULT_DELTA)?,
@@ -275,9 +313,21 @@ pub fn planar(vocabulary: Option<&Arc<BinaryVocabulary>>) -> Result<Vec<Box<dyn 
         out.push(dbow(v, Input::Planar));
         out.push(dbow_checked(v)?);
     }
+    for score in [IbuildScore::Printed, IbuildScore::Symmetric] {
+        for checked in [false, true] {
+            out.push(ibuild_shape(score, SHAPE_DELTA, checked)?);
+        }
+    }
     for delta in DELTAS {
         if delta != DEFAULT_DELTA {
             out.push(ibuild(Input::Planar, delta)?);
+        }
+    }
+    for delta in SHAPE_DELTAS {
+        if delta != SHAPE_DELTA {
+            for checked in [false, true] {
+                out.push(ibuild_shape(IbuildScore::Symmetric, delta, checked)?);
+            }
         }
     }
     Ok(out)

@@ -204,15 +204,27 @@ pub struct LogRows {
     /// The aim rows of the geometric check ([`checked_aims`]).
     #[serde(default)]
     pub checked_aims: Vec<Vec<String>>,
+    /// Rows of the δ sweep of the symmetric IBuILD on scan shapes ([`shape_sweep_rows`]).
+    #[serde(default)]
+    pub shape_sweep: Vec<Vec<String>>,
     /// The PR pictures (markdown; the PNGs are written by the unit).
     pub pictures: String,
     /// The log's figures for the JSON.
     pub json: Value,
 }
 
-/// The IBuILD variants measured against the baselines with the geometric check, each a fixed
-/// choice for every log (none picked per log after the fact).
-pub const CHECKED_VARIANTS: [&str; 2] = ["IBuILD", methods::SYMMETRIC_IBUILD];
+/// The IBuILD variants measured against the baselines with and without the geometric check
+/// (full labels), each a fixed choice for every log (none picked per log after the fact).
+pub fn aim_variants() -> Vec<String> {
+    use methods::{CHECKED, SHAPE_IBUILD, SHAPE_SYMMETRIC, SYMMETRIC_IBUILD};
+    vec![
+        format!("IBuILD{CHECKED}"),
+        format!("{SYMMETRIC_IBUILD}{CHECKED}"),
+        SHAPE_SYMMETRIC.to_string(),
+        format!("{SHAPE_IBUILD}{CHECKED}"),
+        format!("{SHAPE_SYMMETRIC}{CHECKED}"),
+    ]
+}
 
 /// Recall at 100 % precision of the method labelled `label` on the rasterised scans.
 fn recall_at_100(results: &[MethodResult], label: &str, online: bool) -> Option<f64> {
@@ -248,10 +260,10 @@ fn holds(ours: Option<f64>, baselines: &[Option<f64>]) -> String {
 fn checked_aims(name: &str, results: &[MethodResult]) -> Vec<Vec<String>> {
     use methods::CHECKED;
     let mut rows = Vec::new();
-    for variant in CHECKED_VARIANTS {
+    for variant in aim_variants() {
         for online in [true, false] {
             let r = |label: &str| recall_at_100(results, label, online);
-            let ours = r(&format!("{variant}{CHECKED}"));
+            let ours = r(&variant);
             let checked = [
                 r(&format!("DBoW2-style{CHECKED}")),
                 r(&format!("polar context{CHECKED}")),
@@ -260,7 +272,7 @@ fn checked_aims(name: &str, results: &[MethodResult]) -> Vec<Vec<String>> {
             rows.push(vec![
                 name.to_string(),
                 "real".into(),
-                format!("{variant}{CHECKED}"),
+                variant.clone(),
                 if online { "online" } else { "kidnapped" }.into(),
                 super::report::pct(ours),
                 super::report::pct(checked[0]),
@@ -273,6 +285,32 @@ fn checked_aims(name: &str, results: &[MethodResult]) -> Vec<Vec<String>> {
         }
     }
     rows
+}
+
+/// One row per δ of the symmetric IBuILD on scan shapes: online recall at 100 % precision
+/// without and with the geometric check, kidnapped with the check.
+fn shape_sweep_rows(name: &str, results: &[MethodResult]) -> Vec<Vec<String>> {
+    use methods::{CHECKED, SHAPE_DELTA, SHAPE_DELTAS, SHAPE_SYMMETRIC};
+    let find = |label: &str| recall_at_100(results, label, true);
+    SHAPE_DELTAS
+        .iter()
+        .map(|&delta| {
+            let base = if delta == SHAPE_DELTA {
+                SHAPE_SYMMETRIC.to_string()
+            } else {
+                format!("{SHAPE_SYMMETRIC} δ={delta}")
+            };
+            let checked = format!("{base}{CHECKED}");
+            vec![
+                name.to_string(),
+                "real".into(),
+                delta.to_string(),
+                super::report::pct(find(&base)),
+                super::report::pct(find(&checked)),
+                super::report::pct(recall_at_100(results, &checked, false)),
+            ]
+        })
+        .collect()
 }
 
 /// The position of each log of this run in the report (the order of [`LOGS`]).
@@ -358,6 +396,7 @@ fn run_log(
             "DBoW2-style (rasterised scan)",
         ),
         checked_aims: checked_aims(name, &results),
+        shape_sweep: shape_sweep_rows(name, &results),
         pictures: format!("**{name}**\n\n")
             + &pr_figures(figures, FIGURES, &format!("2d-{name}"), &results)?,
         json: json!({

@@ -92,7 +92,7 @@ pub fn pr_figures(
 
 /// True for the extra runs of the δ sweep (kept out of the main tables).
 pub fn is_sweep(r: &MethodResult) -> bool {
-    r.label.starts_with("IBuILD δ=")
+    r.label.contains(" δ=")
 }
 
 /// The header of the δ-sweep table (after the leading sequence columns).
@@ -111,7 +111,7 @@ pub const SWEEP_HEADERS: [&str; 6] = [
 pub fn sweep_rows(leading: &[String], results: &[MethodResult], input: Input) -> Vec<Vec<String>> {
     let mut runs: Vec<(u32, &MethodResult)> = results
         .iter()
-        .filter(|r| r.input == input && r.label.starts_with("IBuILD"))
+        .filter(|r| r.input == input && (r.label == "IBuILD" || r.label.starts_with("IBuILD δ=")))
         .map(|r| {
             let delta = r
                 .label
