@@ -10,7 +10,7 @@
 //!
 //! | method | frames | idea | source |
 //! | --- | --- | --- | --- |
-//! | [`Ibuild`] | images, planar scans, clouds (as images) | online incremental binary bag of words: features tracked over consecutive frames, merged into words, first-match assignment, modified Jaccard score, no training | Khan §4.4 |
+//! | [`Ibuild`] | images, planar scans (as images, or by binary shape descriptors made on the scan: [`PlanarDescriptors::Shape`], ours), clouds (as images) | online incremental binary bag of words: features tracked over consecutive frames, merged into words, first-match assignment, modified Jaccard score, no training | Khan §4.4 |
 //! | [`Dbow`] | same | DBoW2-style vocabulary tree of binary words trained offline, tf–idf, L1 score, inverse and direct index | Gálvez-López & Tardós 2012 |
 //! | [`GlobalDescriptorDb`] (`hog`, `gist`) | same | one global HOG or GIST vector per image, cosine similarity | Khan §4.5.2 |
 //! | [`Shot3dBow`] (`shot`, `shot-intensity`) | clouds | SHOT / intensity-textured SHOT on a voxel grid, words merged by averaging, tf–idf similarity eqs. (4.2)–(4.3) | Khan §4.5.2 |
@@ -23,6 +23,11 @@
 //! [`ScoreMatrix`]) can feed **sequence matching** ([`sequence_match`], SeqSLAM: difference
 //! matrix, local contrast enhancement, straight-line search over `d_s` frames), scored by
 //! [`cross_summary`] against a [`CrossTruth`] (same file name ± a frame tolerance).
+//!
+//! Planar scans can skip the picture: [`scan_shape_descriptors`] gives 512-bit descriptors of
+//! the outline around keypoints along the scan (a polar occupancy grid in the frame of the
+//! local normal), which IBuILD matches and merges like BRIEF bits
+//! ([`IbuildConfig::planar`], ours).
 //!
 //! Images of lidar data come from [`frame_image`]: planar scans are rasterised
 //! ([`rasterize_scan`]), clouds are projected to equirectangular **intensity** or **range**
