@@ -101,7 +101,7 @@ impl Cloud {
 /// One planar laser scan of a log.
 #[pyclass(module = "raypath", frozen)]
 pub struct Scan {
-    frame: PlanarFrame,
+    pub(crate) frame: PlanarFrame,
 }
 
 #[pymethods]
@@ -136,6 +136,18 @@ impl Scan {
     fn pose<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         let p = self.frame.world_from_laser;
         vec1(py, vec![p.x(), p.y(), p.theta()])
+    }
+
+    /// The logged robot pose `(x, y, theta)` (the odometry in a raw log).
+    #[getter]
+    fn odometry<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        crate::arrays::pose_vector(py, self.frame.world_from_robot)
+    }
+
+    /// The laser's mounting `robot_from_laser` `(x, y, theta)`.
+    #[getter]
+    fn robot_from_laser<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        crate::arrays::pose_vector(py, self.frame.robot_from_laser())
     }
 
     /// The sensor time stamp, seconds.

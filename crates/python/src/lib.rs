@@ -14,12 +14,16 @@
 mod arrays;
 mod errors;
 mod io;
+mod localizer;
 mod octree;
 pub mod pipeline;
 mod place;
 mod planes;
 mod poles;
 mod polylines;
+mod registration;
+mod scan_match;
+mod sensor_map;
 mod slam;
 
 use pyo3::prelude::*;
@@ -44,6 +48,14 @@ fn _raypath(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(polylines::ple, m)?)?;
     m.add_class::<polylines::Polyline>()?;
     m.add_class::<place::ScanContext>()?;
+    m.add_function(wrap_pyfunction!(registration::register, m)?)?;
+    m.add_class::<registration::Registration>()?;
+    m.add_class::<scan_match::ScanMatcher>()?;
+    m.add_function(wrap_pyfunction!(scan_match::match_log, m)?)?;
+    m.add_class::<sensor_map::SensorMap>()?;
+    m.add_function(wrap_pyfunction!(sensor_map::build, m)?)?;
+    m.add_function(wrap_pyfunction!(sensor_map::load, m)?)?;
+    m.add_class::<localizer::Localizer>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

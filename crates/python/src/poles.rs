@@ -2,10 +2,10 @@
 
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
-use raypath_geometry::{PointCloud, Pose3};
+use raypath_geometry::Pose3;
 use raypath_poles::{Pole, Preset, extract_poles};
 
-use crate::arrays::{matrix, pose3, vec1};
+use crate::arrays::{matrix, point_cloud, pose3, vec1};
 use crate::errors::{input_error, value_error};
 
 /// Poles found by `raypath.poles.extract`, in the world frame (metres).
@@ -93,15 +93,10 @@ pub fn extract(
             ));
         }
     };
-    let (rows, _) = crate::arrays::points(points, "points", &[3, 4])?;
+    let cloud = point_cloud(points, "points")?;
     let pose = pose3(pose, "pose")?.unwrap_or_else(Pose3::identity);
     let poles = py
         .allow_threads(|| {
-            let cloud = PointCloud::from_points(
-                rows.iter()
-                    .map(|p| nalgebra::Point3::new(p[0] as f32, p[1] as f32, p[2] as f32))
-                    .collect(),
-            );
             let center = nalgebra::Point3::from(pose.translation());
             extract_poles(&[(pose, &cloud)], &center, &preset.extraction)
         })
