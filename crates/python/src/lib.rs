@@ -48,6 +48,8 @@ fn _raypath(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(polylines::ple, m)?)?;
     m.add_class::<polylines::Polyline>()?;
     m.add_class::<place::ScanContext>()?;
+    m.add_class::<place::Ibuild>()?;
+    m.add_class::<place::Dbow>()?;
     m.add_function(wrap_pyfunction!(registration::register, m)?)?;
     m.add_class::<registration::Registration>()?;
     m.add_class::<scan_match::ScanMatcher>()?;
