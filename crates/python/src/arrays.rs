@@ -260,7 +260,7 @@ pub fn point_cloud(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<raypath_geome
 
 /// A planar pose `(x, y, theta)` from a `(3,)` array of finite values.
 pub fn pose2(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<raypath_geometry::Pose2> {
-    let v = vector(obj, name, 3, true)?;
+    let v = vector(obj, name, 0, true)?;
     if v.len() != 3 || !v.iter().all(|c| c.is_finite()) {
         return Err(value_error(
             name,

@@ -6,13 +6,15 @@
 >>> res.map.save("intel.pgm")                     # doctest: +SKIP
 
 Submodules: :mod:`raypath.poles`, :mod:`raypath.planes`, :mod:`raypath.polylines`,
-:mod:`raypath.place_recognition`.
+:mod:`raypath.place_recognition`, :mod:`raypath.registration`,
+:mod:`raypath.scan_match`, :mod:`raypath.sensor_models`.
 """
 
 from ._raypath import (
     Cloud,
     FormatError,
     InputError,
+    Localizer,
     OccupancyMap,
     OccupancyTree,
     PlanarLog,
@@ -24,12 +26,13 @@ from ._raypath import (
     open,
     slam,
 )
-from . import place_recognition, planes, poles, polylines
+from . import place_recognition, planes, poles, polylines, registration, scan_match, sensor_models
 
 __all__ = [
     "Cloud",
     "FormatError",
     "InputError",
+    "Localizer",
     "OccupancyMap",
     "OccupancyTree",
     "PlanarLog",
@@ -43,5 +46,8 @@ __all__ = [
     "planes",
     "poles",
     "polylines",
+    "registration",
+    "scan_match",
+    "sensor_models",
     "slam",
 ]
