@@ -12,6 +12,7 @@
 //! or `FileNotFoundError`. Long work runs with the GIL released.
 
 mod arrays;
+mod dct_map;
 mod errors;
 mod io;
 mod localizer;
@@ -58,6 +59,8 @@ fn _raypath(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sensor_map::build, m)?)?;
     m.add_function(wrap_pyfunction!(sensor_map::load, m)?)?;
     m.add_class::<localizer::Localizer>()?;
+    m.add_class::<dct_map::DctMap>()?;
+    m.add_function(wrap_pyfunction!(dct_map::fit, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

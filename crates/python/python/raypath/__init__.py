@@ -26,7 +26,7 @@ from ._raypath import (
     open,
     slam,
 )
-from . import place_recognition, planes, poles, polylines, registration, scan_match, sensor_models
+from . import dct_map, place_recognition, planes, poles, polylines, registration, scan_match, sensor_models
 
 __all__ = [
     "Cloud",
@@ -41,6 +41,7 @@ __all__ = [
     "SlamResult",
     "SweepLog",
     "__version__",
+    "dct_map",
     "open",
     "place_recognition",
     "planes",
