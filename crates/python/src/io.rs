@@ -246,6 +246,13 @@ pub struct SweepLog {
     format: &'static str,
 }
 
+impl SweepLog {
+    /// The directory or file it was opened from.
+    pub(crate) fn path_buf(&self) -> PathBuf {
+        self.sequence.name.clone()
+    }
+}
+
 #[pymethods]
 impl SweepLog {
     /// The directory or file.

@@ -20,6 +20,7 @@ mod octree;
 pub mod pipeline;
 mod place;
 mod planes;
+mod pole_filter;
 mod poles;
 mod polylines;
 mod registration;
@@ -44,6 +45,8 @@ fn _raypath(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<octree::OccupancyTree>()?;
     m.add_function(wrap_pyfunction!(poles::extract, m)?)?;
     m.add_class::<poles::Poles>()?;
+    m.add_function(wrap_pyfunction!(poles::pole_map, m)?)?;
+    m.add_class::<pole_filter::PoleFilter>()?;
     m.add_function(wrap_pyfunction!(planes::ppe, m)?)?;
     m.add_class::<planes::Plane>()?;
     m.add_function(wrap_pyfunction!(polylines::ple, m)?)?;
