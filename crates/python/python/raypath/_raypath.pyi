@@ -1,7 +1,7 @@
 """Type stubs of the native module `raypath._raypath` (re-exported by `raypath`)."""
 
 import os
-from typing import Callable, Dict, List, Optional, Tuple, Union
+from typing import Callable, Dict, Iterable, List, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -55,6 +55,10 @@ class Scan:
     def max_range(self) -> float: ...
     @property
     def pose(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def odometry(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def robot_from_laser(self) -> npt.NDArray[np.float64]: ...
     @property
     def stamp(self) -> float: ...
     def __len__(self) -> int: ...
@@ -177,6 +181,37 @@ class Poles:
     def __len__(self) -> int: ...
 
 def extract(points: _Floats, pose: Optional[_Floats] = None, preset: str = "kitti") -> Poles: ...
+def map(
+    sequence: Union[SweepLog, _Path],
+    *,
+    preset: Optional[str] = None,
+    sweep_timing: str = "auto",
+    start: int = 0,
+    scans: Optional[int] = None,
+) -> Poles:
+    """The reference pole map of a drive, as `raypath poles map`."""
+
+class PoleFilter:
+    """The pole particle filter on a pole map (seeded)."""
+
+    def __init__(
+        self,
+        map: Union[Poles, _Floats],
+        start: _Floats,
+        *,
+        preset: str = "kitti",
+        particles: Optional[int] = None,
+        seed: int = 0,
+    ) -> None: ...
+    def predict(self, increment: _Floats, std: _Floats) -> None: ...
+    def update(self, poles: _Floats) -> None: ...
+    @property
+    def pose(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def particles(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def resamples(self) -> int: ...
+    def __len__(self) -> int: ...
 
 class Plane:
     """One plane of `raypath.planes.ppe`."""
@@ -214,12 +249,208 @@ def ple(
     max_range: Optional[float] = None,
 ) -> List[Polyline]: ...
 
+_Frame = Union[Scan, Cloud, _Floats]
+_Candidates = List[Tuple[int, float]]
+
 class ScanContext:
     """Scan Context place recognition over 3-D scans."""
 
     def __init__(
         self, num_sectors: int = 60, max_range: float = 80.0, num_candidates: Optional[int] = 10
     ) -> None: ...
-    def add(self, cloud: _Floats) -> int: ...
-    def query(self, cloud: _Floats, k: Optional[int] = None) -> List[Tuple[int, float]]: ...
+    def add(self, frame: _Frame) -> int: ...
+    def query(self, frame: _Frame, k: Optional[int] = None, before: Optional[int] = None) -> _Candidates: ...
+    def add_and_query(self, frame: _Frame, exclusion_frames: int = 50, k: Optional[int] = None) -> _Candidates: ...
     def __len__(self) -> int: ...
+
+class Ibuild:
+    """IBuILD incremental binary bag-of-words place recognition (frames in order)."""
+
+    def __init__(
+        self, delta: Optional[int] = None, window: int = 10, score: str = "printed", upscale: int = 1
+    ) -> None: ...
+    def add(self, frame: _Frame) -> int: ...
+    def query(self, frame: _Frame, k: Optional[int] = None, before: Optional[int] = None) -> _Candidates: ...
+    def add_and_query(self, frame: _Frame, exclusion_frames: int = 50, k: Optional[int] = None) -> _Candidates: ...
+    def __len__(self) -> int: ...
+
+class Dbow:
+    """DBoW2-style bag-of-words place recognition over a trained vocabulary."""
+
+    def __init__(self, vocabulary: _Path, upscale: int = 1) -> None: ...
+    @staticmethod
+    def train(frames: Iterable[_Frame], upscale: int = 1, seed: int = 0) -> "Dbow": ...
+    def save_vocabulary(self, path: _Path) -> None: ...
+    def add(self, frame: _Frame) -> int: ...
+    def query(self, frame: _Frame, k: Optional[int] = None, before: Optional[int] = None) -> _Candidates: ...
+    def add_and_query(self, frame: _Frame, exclusion_frames: int = 50, k: Optional[int] = None) -> _Candidates: ...
+    def __len__(self) -> int: ...
+
+class Registration:
+    """What `raypath.registration.register` found."""
+
+    @property
+    def pose(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def fitness(self) -> float: ...
+    @property
+    def rmse(self) -> float: ...
+    @property
+    def iterations(self) -> int: ...
+    @property
+    def converged(self) -> bool: ...
+    @property
+    def correspondences(self) -> int: ...
+    @property
+    def source_points(self) -> int: ...
+
+def register(
+    source: _Floats,
+    target: _Floats,
+    initial: Optional[_Floats] = None,
+    *,
+    voxel_size: float = 1.0,
+    max_range: float = 100.0,
+    min_range: float = 0.0,
+    kernel: str = "gm",
+) -> Registration:
+    """Point-to-plane ICP of two 3-D scans, as `raypath register SOURCE TARGET`."""
+
+class ScanMatcher:
+    """Hector-style scan-to-map matching of planar scans, one scan at a time."""
+
+    def __init__(
+        self, resolution: float = 0.05, levels: int = 3, size: float = 160.0, max_range: float = 30.0
+    ) -> None: ...
+    def match_scan(
+        self, ranges: _Floats, angles: _Floats, odometry_delta: Optional[_Floats] = None
+    ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+    @property
+    def pose(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def map(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def map_origin(self) -> Tuple[float, float, float]: ...
+    @property
+    def updates(self) -> int: ...
+
+def match_log(
+    log: PlanarLog,
+    *,
+    resolution: float = 0.05,
+    levels: int = 3,
+    size: float = 160.0,
+    max_range: float = 30.0,
+    odometry: bool = False,
+    scans: Optional[int] = None,
+) -> npt.NDArray[np.float64]:
+    """The laser poses (N, 3) of `raypath scan-match LOG`."""
+
+class SensorMap:
+    """A 2-D sensor-model map: hits, misses and path length per cell."""
+
+    def array(self, picture: Optional[str] = None) -> npt.NDArray[np.float64]: ...
+    @property
+    def hits(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def misses(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def path_length(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def resolution(self) -> float: ...
+    @property
+    def origin(self) -> Tuple[float, float]: ...
+    @property
+    def shape(self) -> Tuple[int, int]: ...
+    @property
+    def model(self) -> str: ...
+    @property
+    def posterior(self) -> bool: ...
+    @property
+    def range(self) -> Tuple[float, float]: ...
+    def save(self, path: _Path) -> None: ...
+
+def build(
+    log: PlanarLog,
+    poses: Optional[_Floats] = None,
+    *,
+    model: str = "reflection",
+    resolution: float = 0.05,
+    max_range: float = 80.0,
+    min_range: float = 0.0,
+    ray_step: int = 1,
+    skip_no_returns: bool = False,
+    posterior: bool = False,
+) -> SensorMap:
+    """A sensor-model map of a planar log, as `raypath map LOG --model M --resolution R`."""
+
+def load(path: _Path) -> SensorMap:
+    """Reads a 2-D `.rpmap` written by `raypath map` or `SensorMap.save`."""
+
+class Localizer:
+    """Monte-Carlo localization on a SensorMap, one scan at a time (seeded)."""
+
+    def __init__(
+        self,
+        map: SensorMap,
+        initial: _Floats,
+        *,
+        particles: int = 1000,
+        seed: int = 0,
+        model: Optional[str] = None,
+        exact: bool = False,
+        beam_step: int = 1,
+        effective_beams: float = 8.0,
+        robot_from_laser: Optional[_Floats] = None,
+    ) -> None: ...
+    def step(
+        self,
+        odometry: _Floats,
+        ranges: Union[Scan, _Floats],
+        angles: Optional[_Floats] = None,
+        *,
+        max_range: Optional[float] = None,
+        force: bool = False,
+    ) -> bool: ...
+    @property
+    def pose(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def particles(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def weights(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def updates(self) -> int: ...
+    @property
+    def failed_updates(self) -> int: ...
+    @property
+    def resamplings(self) -> int: ...
+    @property
+    def model(self) -> str: ...
+    def __len__(self) -> int: ...
+
+class DctMap:
+    """A fitted DCT decay-rate map over a patch, with its grid baseline and scores."""
+
+    @property
+    def coefficients(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def patch(self) -> Tuple[float, float, float, float]: ...
+    def rate_at(self, points: _Floats) -> npt.NDArray[np.float64]: ...
+    def rates(self, cell: float = 0.05) -> npt.NDArray[np.float64]: ...
+    @property
+    def baseline(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def baseline_cell(self) -> float: ...
+    @property
+    def scores(self) -> Dict[str, float]: ...
+    def save(self, path: _Path) -> None: ...
+
+def fit(
+    log: PlanarLog,
+    coefficients: Tuple[int, int],
+    *,
+    patch: Optional[Tuple[float, float, float, float]] = None,
+    rays: int = 10000,
+    seed: int = 9,
+) -> DctMap:
+    """A DCT decay-rate map of a planar log's rays, as `raypath dct-map LOG --coefficients L,M`."""
