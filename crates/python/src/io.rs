@@ -306,7 +306,7 @@ impl SweepLog {
     }
 }
 
-fn normalize(index: isize, len: usize) -> PyResult<usize> {
+pub(crate) fn normalize(index: isize, len: usize) -> PyResult<usize> {
     let i = if index < 0 {
         index + len as isize
     } else {
@@ -332,6 +332,7 @@ pub fn read_planar(path: &std::path::Path) -> Result<Vec<PlanarFrame>, raypath_i
 ///   its LaserScan topic, else `SweepLog` for its PointCloud2 topic;
 /// * a KITTI sequence directory, an NCLT session directory, an Ouster `.pcap` with its
 ///   metadata JSON beside it → `SweepLog`;
+/// * an OctoMap occupancy tree `.bt` → `OctreeMap`, a scan graph `.graph` → `ScanGraph`;
 /// * a PCD file, a KITTI velodyne `.bin` or an `x y z` text file → `Cloud`.
 ///
 /// Raises `FileNotFoundError` for a missing path and `raypath.FormatError` (with `path`,
@@ -358,6 +359,24 @@ pub fn open(py: Python<'_>, path: PathBuf) -> PyResult<PyObject> {
                 }
             }
         },
+        Format::OctomapBt => {
+            let tree = py
+                .allow_threads(|| raypath_io::octomap::read_bt(&path))
+                .map_err(io_error)?;
+            Ok(crate::octomap::OctreeMap { tree }
+                .into_pyobject(py)?
+                .into_any()
+                .unbind())
+        }
+        Format::OctomapGraph => {
+            let graph = py
+                .allow_threads(|| raypath_io::octomap::read_graph(&path))
+                .map_err(io_error)?;
+            Ok(crate::octomap::ScanGraph { graph }
+                .into_pyobject(py)?
+                .into_any()
+                .unbind())
+        }
         Format::KittiSequence | Format::NcltSession | Format::OusterPcap => {
             let sequence = py
                 .allow_threads(|| SweepSequence::open(&path, &SweepOptions::default()))

@@ -16,6 +16,7 @@ mod dct_map;
 mod errors;
 mod io;
 mod localizer;
+mod octomap;
 mod octree;
 pub mod pipeline;
 mod place;
@@ -39,6 +40,8 @@ fn _raypath(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<io::Scan>()?;
     m.add_class::<io::PlanarLog>()?;
     m.add_class::<io::SweepLog>()?;
+    m.add_class::<octomap::OctreeMap>()?;
+    m.add_class::<octomap::ScanGraph>()?;
     m.add_function(wrap_pyfunction!(slam::slam, m)?)?;
     m.add_class::<slam::SlamResult>()?;
     m.add_class::<slam::OccupancyMap>()?;
