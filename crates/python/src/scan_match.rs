@@ -16,6 +16,9 @@ use crate::arrays::{matrix, pose_vector, pose2, poses2, scan2};
 use crate::errors::{input_error, value_error};
 use crate::io::PlanarLog;
 
+/// A pose `(3,)` and its covariance `(3, 3)`.
+type PoseAndCovariance<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>);
+
 /// The matcher and point filter of the arguments (`raypath scan-match`'s flags and defaults).
 fn settings(
     resolution: f64,
@@ -90,7 +93,7 @@ impl ScanMatcher {
         ranges: &Bound<'py, PyAny>,
         angles: &Bound<'py, PyAny>,
         odometry_delta: Option<&Bound<'py, PyAny>>,
-    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>)> {
+    ) -> PyResult<PoseAndCovariance<'py>> {
         let scan = scan2(ranges, angles, None)?;
         let delta = match odometry_delta.filter(|d| !d.is_none()) {
             Some(d) => Some(pose2(d, "odometry_delta")?),
