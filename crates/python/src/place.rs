@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use numpy::{PyArray2, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{PyArray2, PyArrayDescrMethods, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use raypath_place_recognition::{
     BinaryVocabulary, Candidate, Dbow as DbowDatabase, DbowConfig, Ibuild as IbuildDatabase,
@@ -37,14 +37,24 @@ fn frame(obj: &Bound<'_, PyAny>) -> PyResult<OwnedFrame> {
                 )
             });
     }
-    point_cloud(obj, "frame")
-        .map(OwnedFrame::Cloud)
-        .map_err(|e| {
-            value_error(
+    if let Ok(array) = obj.downcast::<numpy::PyUntypedArray>() {
+        let py = obj.py();
+        let dtype = array.dtype();
+        if !(dtype.is_equiv_to(&numpy::dtype::<f64>(py))
+            || dtype.is_equiv_to(&numpy::dtype::<f32>(py)))
+        {
+            return Err(value_error(
                 "frame",
-                format!("expected a raypath.Scan, a raypath.Cloud, an (N, 3) or (N, 4) float array or an (H, W) uint8 image ({e})"),
-            )
-        })
+                format!(
+                    "expected a raypath.Scan, a raypath.Cloud, an (N, 3) or (N, 4) float32/float64 \
+                     array or an (H, W) uint8 image, got a {dtype} array of shape {:?}",
+                    array.shape()
+                ),
+            ));
+        }
+    }
+    // Points (an array or anything NumPy reads as one): their own messages.
+    point_cloud(obj, "frame").map(OwnedFrame::Cloud)
 }
 
 /// What every recognizer binding does with its database; the classes below only build
