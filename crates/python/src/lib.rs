@@ -59,6 +59,7 @@ fn _raypath(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<place::Dbow>()?;
     m.add_function(wrap_pyfunction!(registration::register, m)?)?;
     m.add_class::<registration::Registration>()?;
+    m.add_class::<registration::Odometry>()?;
     m.add_class::<scan_match::ScanMatcher>()?;
     m.add_function(wrap_pyfunction!(scan_match::match_log, m)?)?;
     m.add_class::<sensor_map::SensorMap>()?;

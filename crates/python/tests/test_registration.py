@@ -83,3 +83,22 @@ def test_bad_input(kwargs, message):
 def test_too_few_points_is_an_input_error():
     with pytest.raises(raypath.InputError):
         raypath.registration.register(np.zeros((3, 3)), np.zeros((3, 3)))
+
+
+def test_odometry_equals_the_cli(data, cli):
+    sequence = need(data / "kitti/sequences/00")
+    theirs = cli("register", sequence, "--frames", 4)["steps"]
+    seq = raypath.open(sequence)
+    odometry = raypath.registration.Odometry()
+    for k, step in enumerate(theirs):
+        pose, found = odometry.register_frame(seq[k].points)
+        np.testing.assert_array_equal(pose[:3, 3], step["translation_m"])
+        if k == 0:
+            assert found is None and step["iterations"] is None
+        else:
+            assert found.fitness == step["fitness"] and found.iterations == step["iterations"]
+    assert odometry.poses.shape == (4, 4, 4) and len(odometry) == 4
+    with pytest.raises(ValueError, match="kernel"):
+        raypath.registration.Odometry(kernel="x")
+    with pytest.raises(ValueError, match="points"):
+        odometry.register_frame(np.zeros((4, 2)))

@@ -354,6 +354,17 @@ def register(
 ) -> Registration:
     """Point-to-plane ICP of two 3-D scans, as `raypath register SOURCE TARGET`."""
 
+class Odometry:
+    """KISS-ICP-style lidar odometry over a sequence, as `raypath register SEQUENCE`."""
+
+    def __init__(
+        self, *, voxel_size: float = 1.0, max_range: float = 100.0, min_range: float = 0.0, kernel: str = "gm"
+    ) -> None: ...
+    def register_frame(self, points: _Floats) -> Tuple[npt.NDArray[np.float64], Optional[Registration]]: ...
+    @property
+    def poses(self) -> npt.NDArray[np.float64]: ...
+    def __len__(self) -> int: ...
+
 class ScanMatcher:
     """Hector-style scan-to-map matching of planar scans, one scan at a time."""
 
