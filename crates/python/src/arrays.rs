@@ -179,6 +179,11 @@ pub fn pose3(
         .ok_or_else(|| value_error(name, "the upper-left 3 × 3 block is not a rotation"))
 }
 
+/// One planar pose as a `(3,)` array `x, y, theta`.
+pub fn pose_vector(py: Python<'_>, pose: raypath_geometry::Pose2) -> Bound<'_, PyArray1<f64>> {
+    vec1(py, vec![pose.x(), pose.y(), pose.theta()])
+}
+
 /// `(N, 3)` array of poses `x, y, theta`.
 pub fn poses2<'py>(
     py: Python<'py>,
@@ -194,21 +199,33 @@ pub fn poses3<'py>(
     py: Python<'py>,
     poses: &[raypath_geometry::Pose3],
 ) -> Bound<'py, PyArray3<f64>> {
-    let mut flat = Vec::with_capacity(poses.len() * 16);
-    for p in poses {
-        let m = p.to_matrix3x4();
-        for r in 0..3 {
-            for c in 0..4 {
-                flat.push(m[(r, c)]);
-            }
-        }
-        flat.extend_from_slice(&[0.0, 0.0, 0.0, 1.0]);
-    }
+    let flat: Vec<f64> = poses.iter().flat_map(homogeneous).collect();
     match Array3::from_shape_vec((poses.len(), 4, 4), flat) {
         Ok(a) => a.into_pyarray(py),
         // The length is 16 per pose by construction.
         Err(_) => Array3::zeros((0, 4, 4)).into_pyarray(py),
     }
+}
+
+/// One rigid transform as a `(4, 4)` array.
+pub fn pose3_matrix<'py>(
+    py: Python<'py>,
+    pose: &raypath_geometry::Pose3,
+) -> Bound<'py, PyArray2<f64>> {
+    matrix(py, homogeneous(pose).to_vec(), 4, 4)
+}
+
+/// The 16 values of a rigid transform's homogeneous matrix, row-major.
+fn homogeneous(pose: &raypath_geometry::Pose3) -> [f64; 16] {
+    let m = pose.to_matrix3x4();
+    let mut out = [0.0; 16];
+    for r in 0..3 {
+        for c in 0..4 {
+            out[4 * r + c] = m[(r, c)];
+        }
+    }
+    out[15] = 1.0;
+    out
 }
 
 /// A row-major `(rows, cols)` array from `flat` (`rows · cols` values).
@@ -228,4 +245,84 @@ pub fn matrix<T: numpy::Element + Default + Clone>(
 /// A 1-D array.
 pub fn vec1<T: numpy::Element>(py: Python<'_>, v: Vec<T>) -> Bound<'_, PyArray1<T>> {
     v.into_pyarray(py)
+}
+
+/// An `(N, 3)` or `(N, 4)` float array as a point cloud in single precision (a fourth
+/// column, such as KITTI's reflectance, is ignored), as the readers of `raypath_io` give it.
+pub fn point_cloud(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<raypath_geometry::PointCloud> {
+    let (rows, _) = points(obj, name, &[3, 4])?;
+    Ok(raypath_geometry::PointCloud::from_points(
+        rows.iter()
+            .map(|p| nalgebra::Point3::new(p[0] as f32, p[1] as f32, p[2] as f32))
+            .collect(),
+    ))
+}
+
+/// A planar pose `(x, y, theta)` from a `(3,)` array of finite values.
+pub fn pose2(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<raypath_geometry::Pose2> {
+    let v = vector(obj, name, 0, true)?;
+    if v.len() != 3 || !v.iter().all(|c| c.is_finite()) {
+        return Err(value_error(
+            name,
+            format!("expected a pose (x, y, theta) of shape (3,) with finite values, got {v:?}"),
+        ));
+    }
+    Ok(raypath_geometry::Pose2::new(v[0], v[1], v[2]))
+}
+
+/// A planar scan from `(B,)` ranges and angles (B ≥ 2, angles evenly spaced and increasing,
+/// radians): ranges at or above `max_range` (default infinity) and infinite ranges are
+/// no-returns; NaN and negative ranges are refused.
+pub fn scan2(
+    ranges: &Bound<'_, PyAny>,
+    angles: &Bound<'_, PyAny>,
+    max_range: Option<f64>,
+) -> PyResult<raypath_geometry::Scan2> {
+    let ranges = vector(ranges, "ranges", 2, false)?;
+    let angles = vector(angles, "angles", 2, false)?;
+    if ranges.len() != angles.len() {
+        return Err(value_error(
+            "angles",
+            format!(
+                "expected shape ({},) like ranges, got ({},)",
+                ranges.len(),
+                angles.len()
+            ),
+        ));
+    }
+    if let Some(i) = ranges.iter().position(|r| r.is_nan()) {
+        return Err(value_error("ranges", format!("value {i} is NaN")));
+    }
+    if let Some(i) = ranges.iter().position(|&r| r < 0.0) {
+        return Err(value_error(
+            "ranges",
+            format!("value {i} is negative ({})", ranges[i]),
+        ));
+    }
+    if !angles.iter().all(|a| a.is_finite()) {
+        return Err(value_error("angles", "not finite"));
+    }
+    let n = angles.len();
+    let step = (angles[n - 1] - angles[0]) / (n - 1) as f64;
+    let tolerance = 1e-6 * step.abs().max(1e-9);
+    if step <= 0.0
+        || angles
+            .iter()
+            .enumerate()
+            .any(|(i, a)| (a - (angles[0] + step * i as f64)).abs() > tolerance.max(1e-9))
+    {
+        return Err(value_error(
+            "angles",
+            "must be evenly spaced and increasing",
+        ));
+    }
+    let scan = raypath_geometry::Scan2 {
+        angle_min_rad: angles[0],
+        angle_increment_rad: step,
+        max_range_m: max_range.unwrap_or(f64::INFINITY),
+        ranges,
+        intensities: None,
+    };
+    scan.validate().map_err(|e| value_error("max_range", e))?;
+    Ok(scan)
 }

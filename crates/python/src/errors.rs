@@ -50,6 +50,20 @@ pub fn io_error(error: raypath_io::Error) -> PyErr {
     err
 }
 
+/// A file that does not follow its format (no place in it known): `FormatError` with
+/// `path`, `line = byte = None`.
+pub fn format_error(path: &std::path::Path, message: impl std::fmt::Display) -> PyErr {
+    let err = FormatError::new_err(format!("{}: {message}", path.display()));
+    Python::with_gil(|py| {
+        let value = err.value(py);
+        // As in `io_error`: the message names the file when this fails.
+        let _ = value.setattr("path", path.display().to_string());
+        let _ = value.setattr("line", None::<u64>);
+        let _ = value.setattr("byte", None::<u64>);
+    });
+    err
+}
+
 /// An error about data the algorithm cannot use.
 pub fn input_error(message: impl std::fmt::Display) -> PyErr {
     InputError::new_err(message.to_string())

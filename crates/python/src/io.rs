@@ -101,7 +101,7 @@ impl Cloud {
 /// One planar laser scan of a log.
 #[pyclass(module = "raypath", frozen)]
 pub struct Scan {
-    frame: PlanarFrame,
+    pub(crate) frame: PlanarFrame,
 }
 
 #[pymethods]
@@ -136,6 +136,18 @@ impl Scan {
     fn pose<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         let p = self.frame.world_from_laser;
         vec1(py, vec![p.x(), p.y(), p.theta()])
+    }
+
+    /// The logged robot pose `(x, y, theta)` (the odometry in a raw log).
+    #[getter]
+    fn odometry<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        crate::arrays::pose_vector(py, self.frame.world_from_robot)
+    }
+
+    /// The laser's mounting `robot_from_laser` `(x, y, theta)`.
+    #[getter]
+    fn robot_from_laser<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        crate::arrays::pose_vector(py, self.frame.robot_from_laser())
     }
 
     /// The sensor time stamp, seconds.
@@ -234,6 +246,13 @@ pub struct SweepLog {
     format: &'static str,
 }
 
+impl SweepLog {
+    /// The directory or file it was opened from.
+    pub(crate) fn path_buf(&self) -> PathBuf {
+        self.sequence.name.clone()
+    }
+}
+
 #[pymethods]
 impl SweepLog {
     /// The directory or file.
@@ -287,7 +306,7 @@ impl SweepLog {
     }
 }
 
-fn normalize(index: isize, len: usize) -> PyResult<usize> {
+pub(crate) fn normalize(index: isize, len: usize) -> PyResult<usize> {
     let i = if index < 0 {
         index + len as isize
     } else {
@@ -313,6 +332,7 @@ pub fn read_planar(path: &std::path::Path) -> Result<Vec<PlanarFrame>, raypath_i
 ///   its LaserScan topic, else `SweepLog` for its PointCloud2 topic;
 /// * a KITTI sequence directory, an NCLT session directory, an Ouster `.pcap` with its
 ///   metadata JSON beside it → `SweepLog`;
+/// * an OctoMap occupancy tree `.bt` → `OctreeMap`, a scan graph `.graph` → `ScanGraph`;
 /// * a PCD file, a KITTI velodyne `.bin` or an `x y z` text file → `Cloud`.
 ///
 /// Raises `FileNotFoundError` for a missing path and `raypath.FormatError` (with `path`,
@@ -339,6 +359,24 @@ pub fn open(py: Python<'_>, path: PathBuf) -> PyResult<PyObject> {
                 }
             }
         },
+        Format::OctomapBt => {
+            let tree = py
+                .allow_threads(|| raypath_io::octomap::read_bt(&path))
+                .map_err(io_error)?;
+            Ok(crate::octomap::OctreeMap { tree }
+                .into_pyobject(py)?
+                .into_any()
+                .unbind())
+        }
+        Format::OctomapGraph => {
+            let graph = py
+                .allow_threads(|| raypath_io::octomap::read_graph(&path))
+                .map_err(io_error)?;
+            Ok(crate::octomap::ScanGraph { graph }
+                .into_pyobject(py)?
+                .into_any()
+                .unbind())
+        }
         Format::KittiSequence | Format::NcltSession | Format::OusterPcap => {
             let sequence = py
                 .allow_threads(|| SweepSequence::open(&path, &SweepOptions::default()))

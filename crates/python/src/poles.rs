@@ -1,17 +1,23 @@
 //! `raypath.poles.extract`: pole landmarks from a registered 3-D scan.
 
+use std::path::PathBuf;
+
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
-use raypath_geometry::{PointCloud, Pose3};
-use raypath_poles::{Pole, Preset, extract_poles};
+use raypath_geometry::Pose3;
+use raypath_io::sequence::{SweepOptions, SweepSequence};
+use raypath_poles::{
+    Drive, DriveFormat, Pole, Preset, SweepTiming, extract_poles, local_maps, reference_map,
+};
 
-use crate::arrays::{matrix, pose3, vec1};
-use crate::errors::{input_error, value_error};
+use crate::arrays::{matrix, point_cloud, pose3, vec1};
+use crate::errors::{input_error, io_error, value_error};
+use crate::io::SweepLog;
 
 /// Poles found by `raypath.poles.extract`, in the world frame (metres).
 #[pyclass(module = "raypath.poles", name = "Poles", frozen)]
 pub struct Poles {
-    poles: Vec<Pole>,
+    pub(crate) poles: Vec<Pole>,
 }
 
 #[pymethods]
@@ -67,6 +73,17 @@ impl Poles {
     }
 }
 
+pub(crate) fn preset_of(name: &str) -> PyResult<Preset> {
+    match name {
+        "kitti" => Ok(Preset::kitti()),
+        "nclt" => Ok(Preset::nclt()),
+        other => Err(value_error(
+            "preset",
+            format!("expected \"kitti\" or \"nclt\", got {other:?}"),
+        )),
+    }
+}
+
 /// Extracts poles from one 3-D scan (Schaefer 2020, ch. 12): a local hit/miss voxel map
 /// traced from the sensor, Beta-posterior occupancy, pole scores, mean-shift centres.
 ///
@@ -83,29 +100,100 @@ pub fn extract(
     pose: Option<&Bound<'_, PyAny>>,
     preset: &str,
 ) -> PyResult<Poles> {
-    let preset = match preset {
-        "kitti" => Preset::kitti(),
-        "nclt" => Preset::nclt(),
-        other => {
-            return Err(value_error(
-                "preset",
-                format!("expected \"kitti\" or \"nclt\", got {other:?}"),
-            ));
-        }
-    };
-    let (rows, _) = crate::arrays::points(points, "points", &[3, 4])?;
+    let preset = preset_of(preset)?;
+    let cloud = point_cloud(points, "points")?;
     let pose = pose3(pose, "pose")?.unwrap_or_else(Pose3::identity);
     let poles = py
         .allow_threads(|| {
-            let cloud = PointCloud::from_points(
-                rows.iter()
-                    .map(|p| nalgebra::Point3::new(p[0] as f32, p[1] as f32, p[2] as f32))
-                    .collect(),
-            );
             let center = nalgebra::Point3::from(pose.translation());
             extract_poles(&[(pose, &cloud)], &center, &preset.extraction)
         })
         .map_err(input_error)?
         .0;
+    Ok(Poles { poles })
+}
+
+/// The sweep timing of `sweep_timing` for `drive` (`"auto"`: KITTI's de-skewed sweeps for a
+/// KITTI sequence that is not a `raypath simulate` set, as `raypath poles`).
+fn sweep_timing(drive: &Drive, path: &std::path::Path, name: &str) -> PyResult<bool> {
+    Ok(match name {
+        "kitti" => true,
+        "origin" => false,
+        "auto" => {
+            let simulated = path
+                .ancestors()
+                .skip(1)
+                .take(2)
+                .any(|dir| dir.join("set.json").is_file());
+            drive.format() == DriveFormat::Kitti && !simulated
+        }
+        other => {
+            return Err(value_error(
+                "sweep_timing",
+                format!("expected \"auto\", \"kitti\" or \"origin\", got {other:?}"),
+            ));
+        }
+    })
+}
+
+/// A pole map of a whole drive, as `raypath poles map SEQUENCE`: local maps along the
+/// reference trajectory (the odometry when there is none), their poles merged into one
+/// reference map (world frame).
+///
+/// `sequence`: a `SweepLog` (KITTI sequence, NCLT session, bag) or its path. `preset`:
+/// `"kitti"`, `"nclt"`, or None for the sequence's format. `sweep_timing`: `"auto"`,
+/// `"kitti"` (rays start where the sensor was when it fired) or `"origin"`. `start`,
+/// `scans`: the scans used (`--from`, `--max-scans`). The GIL is released while it maps.
+#[pyfunction(name = "map")]
+#[pyo3(signature = (sequence, *, preset = None, sweep_timing = "auto", start = 0, scans = None))]
+pub fn pole_map(
+    py: Python<'_>,
+    sequence: &Bound<'_, PyAny>,
+    preset: Option<&str>,
+    sweep_timing: &str,
+    start: usize,
+    scans: Option<usize>,
+) -> PyResult<Poles> {
+    let path: PathBuf = match sequence.downcast::<SweepLog>() {
+        Ok(log) => log.get().path_buf(),
+        Err(_) => sequence.extract().map_err(|_| {
+            value_error(
+                "sequence",
+                "expected a raypath.SweepLog or the path of a sequence",
+            )
+        })?,
+    };
+    let sweeps = py
+        .allow_threads(|| SweepSequence::open(&path, &SweepOptions::default()))
+        .map_err(io_error)?;
+    let mut drive = Drive::new(sweeps).map_err(input_error)?;
+    if self::sweep_timing(&drive, &path, sweep_timing)? {
+        drive.sweep_timing = Some(SweepTiming::kitti());
+    }
+    let preset = match preset {
+        Some(name) => preset_of(name)?,
+        None => match drive.format() {
+            DriveFormat::Kitti => Preset::kitti(),
+            DriveFormat::Nclt => Preset::nclt(),
+        },
+    };
+    if start >= drive.len() {
+        return Err(value_error(
+            "start",
+            format!("{start} but the sequence has {} scans", drive.len()),
+        ));
+    }
+    let end = scans.map_or(drive.len(), |n| (start + n).min(drive.len()));
+    let track: Vec<Pose3> = drive
+        .sweeps
+        .reference
+        .clone()
+        .unwrap_or_else(|| drive.odometry().to_vec());
+    let poles = py
+        .allow_threads(|| {
+            local_maps(&drive, &track, start..end, &preset, |_, _| {})
+                .map(|(maps, _)| reference_map(&maps, &preset))
+        })
+        .map_err(input_error)?;
     Ok(Poles { poles })
 }

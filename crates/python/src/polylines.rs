@@ -2,10 +2,9 @@
 
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
-use raypath_geometry::Scan2;
 use raypath_polylines::{Method, PolylineConfig, extract};
 
-use crate::arrays::{matrix, vec1, vector};
+use crate::arrays::{matrix, scan2, vec1};
 use crate::errors::{input_error, value_error};
 
 /// One polyline (open) or polygon (closed), vertices in the scan frame.
@@ -83,52 +82,7 @@ pub fn ple(
             ));
         }
     };
-    let ranges = vector(ranges, "ranges", 2, false)?;
-    let angles = vector(angles, "angles", 2, false)?;
-    if ranges.len() != angles.len() {
-        return Err(value_error(
-            "angles",
-            format!(
-                "expected shape ({},) like ranges, got ({},)",
-                ranges.len(),
-                angles.len()
-            ),
-        ));
-    }
-    if let Some(i) = ranges.iter().position(|r| r.is_nan()) {
-        return Err(value_error("ranges", format!("value {i} is NaN")));
-    }
-    if let Some(i) = ranges.iter().position(|&r| r < 0.0) {
-        return Err(value_error(
-            "ranges",
-            format!("value {i} is negative ({})", ranges[i]),
-        ));
-    }
-    if !angles.iter().all(|a| a.is_finite()) {
-        return Err(value_error("angles", "not finite"));
-    }
-    let n = angles.len();
-    let step = (angles[n - 1] - angles[0]) / (n - 1) as f64;
-    let tolerance = 1e-6 * step.abs().max(1e-9);
-    if step <= 0.0
-        || angles
-            .iter()
-            .enumerate()
-            .any(|(i, a)| (a - (angles[0] + step * i as f64)).abs() > tolerance.max(1e-9))
-    {
-        return Err(value_error(
-            "angles",
-            "must be evenly spaced and increasing",
-        ));
-    }
-    let scan = Scan2 {
-        angle_min_rad: angles[0],
-        angle_increment_rad: step,
-        max_range_m: max_range.unwrap_or(f64::INFINITY),
-        ranges,
-        intensities: None,
-    };
-    scan.validate().map_err(|e| value_error("max_range", e))?;
+    let scan = scan2(ranges, angles, max_range)?;
     let config = PolylineConfig {
         max_edge_m: max_edge,
         ..PolylineConfig::new(method, max_vertices)

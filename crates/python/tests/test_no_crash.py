@@ -65,6 +65,11 @@ def test_mutated_kitti_bin(data, tmp_path):
         lambda a: raypath.planes.ppe(a.reshape(-1, 1, 3) if a.ndim == 2 and a.shape[1] == 3 else a),
         lambda a: raypath.place_recognition.ScanContext().add(a),
         lambda a: raypath.OccupancyTree().insert(a, [0, 0, 0]),
+        lambda a: raypath.registration.register(a, a),
+        lambda a: raypath.place_recognition.Ibuild().add(a),
+        lambda a: raypath.poles.PoleFilter(a[:, :2], [0, 0, 0], particles=10),
+        lambda a: raypath.scan_match.ScanMatcher().match_scan(
+            a.ravel(), np.linspace(0.0, 1.0, a.size)),
     ],
 )
 def test_hostile_arrays(call):

@@ -61,3 +61,53 @@ def test_bad_pose_and_preset():
     with pytest.raises(ValueError, match="preset"):
         raypath.poles.extract(points, preset="nope")
     assert len(raypath.poles.extract(points, pose=np.eye(4, dtype=int), preset="nclt")) == 0
+
+
+def test_pole_map_equals_the_cli(data, cli, tmp_path):
+    sequence = need(data / "kitti/sequences/00")
+    theirs = cli("poles", "map", sequence, "--out", tmp_path / "map.csv")["poles"]
+    ours = raypath.poles.map(raypath.open(sequence))
+    assert len(ours) == len(theirs) > 0
+    np.testing.assert_array_equal(ours.xy, [[p["x"], p["y"]] for p in theirs])
+    np.testing.assert_array_equal(ours.width, [p["width"] for p in theirs])
+    np.testing.assert_array_equal(ours.height, [p["height"] for p in theirs])
+    np.testing.assert_array_equal(ours.score, [p["score"] for p in theirs])
+    # A path is the same input.
+    np.testing.assert_array_equal(raypath.poles.map(sequence).xy, ours.xy)
+
+
+def test_pole_filter_on_a_map():
+    rng = np.random.default_rng(5)
+    poles = rng.uniform(-30, 30, size=(40, 2))
+    truth = np.array([1.0, -2.0, 0.3])
+    pf = raypath.poles.PoleFilter(poles, truth + [0.5, -0.5, 0.05], particles=500, seed=4)
+    again = raypath.poles.PoleFilter(poles, truth + [0.5, -0.5, 0.05], particles=500, seed=4)
+    c, s = np.cos(truth[2]), np.sin(truth[2])
+    d = poles - truth[:2]
+    seen = np.column_stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]])
+    seen = seen[np.linalg.norm(seen, axis=1) < 25]
+    for f in (pf, again):
+        for _ in range(5):
+            f.predict([0.0, 0.0, 0.0], [0.05, 0.05, 0.01])
+            f.update(seen)
+    np.testing.assert_array_equal(pf.particles, again.particles)
+    assert np.linalg.norm(pf.pose[:2] - truth[:2]) < 0.3
+    assert pf.particles.shape == (500, 3) and len(pf) == 500
+
+
+def test_pole_filter_bad_input(data):
+    with pytest.raises(ValueError, match=r"map: expected Poles or an array of shape \(M, 2\)"):
+        raypath.poles.PoleFilter(np.zeros((3, 3)), [0, 0, 0])
+    with pytest.raises(ValueError, match="start"):
+        raypath.poles.PoleFilter(np.zeros((3, 2)), [0, 0])
+    with pytest.raises(ValueError, match="preset"):
+        raypath.poles.PoleFilter(np.zeros((3, 2)), [0, 0, 0], preset="mars")
+    pf = raypath.poles.PoleFilter(np.zeros((3, 2)), [0, 0, 0], particles=10)
+    with pytest.raises(ValueError, match=r"poles: expected an array of shape \(K, 2\)"):
+        pf.update(np.zeros(4))
+    with pytest.raises(ValueError, match=r"std: expected shape \(3,\)"):
+        pf.predict([0, 0, 0], [1, 1])
+    with pytest.raises(ValueError, match="sweep_timing"):
+        raypath.poles.map(data / "kitti/sequences/00", sweep_timing="late")
+    with pytest.raises(ValueError, match="sequence"):
+        raypath.poles.map(3)
