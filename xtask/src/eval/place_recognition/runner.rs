@@ -40,7 +40,7 @@ impl Input {
     /// The view in words, for tables.
     pub fn name(self) -> &'static str {
         match self {
-            Input::Planar => "rasterised scan",
+            Input::Planar => "planar scan",
             Input::Cloud => "point cloud",
             Input::Intensity => "intensity image",
             Input::Range => "range image",

@@ -117,7 +117,8 @@ fn write_intro(md: &mut String, quick: bool) -> Result<()> {
          ever described by a vocabulary that saw it ({} evenly spaced scans per training log; \
          list below). IBuILD needs no training (its vocabulary grows online). Both read the \
          same rasterised scans (0.1 m pixels over ±15 m; ours) and FAST/BRIEF-512 features; \
-         the polar context reads the end points. Rows \"+ geometric check\" are the same \
+         the polar context reads the end points, and IBuILD \"on scan shapes\" binary shape \
+         descriptors made on the scan (no raster). Rows \"+ geometric check\" are the same \
          methods with their best candidates re-scored by how well the two scans align \
          (`GeometricCheck`, ours; settings below the results table).\n",
         FOLDS[0].join(", "),
