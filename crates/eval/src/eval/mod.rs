@@ -1,11 +1,15 @@
-//! The evaluation registry and the report writer shared by all evaluations.
+//! The evaluation registry: one table of every evaluation (name, what it measures, how it
+//! runs) in the order `all` runs them, and the entry points that run one, all, a shard or a
+//! merge by name.
 //!
-//! Every evaluation is a function `run(&EvalContext) -> Result<EvalReport>`. The framework
-//! prints the report, writes `docs/results/<name>.md` (with the command, date, machine and
-//! data directory) and `target/eval/<name>.json`.
+//! Every evaluation is a function `run(&EvalContext) -> Result<EvalReport>` or written in
+//! stages ([`stages`]); either way the quick or full run is the context's `quick` flag. The
+//! runner prints the report and writes `docs/results/<name>.md` (with the command, date,
+//! machine and data directory) and `target/eval/<name>.json` ([`report`]).
 
 mod carmen_angles;
 mod comparable;
+mod context;
 mod corridor;
 mod dct;
 mod geometry;
@@ -19,6 +23,7 @@ mod poles_kitti;
 mod poles_nclt;
 mod polylines;
 mod registration;
+mod report;
 mod scan_matching;
 mod segcomp;
 mod sensor_models;
@@ -28,126 +33,15 @@ mod slam_map;
 pub mod stages;
 mod synpeb;
 
-use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use indicatif::{ProgressBar, ProgressStyle};
 
-/// What an evaluation gets: where things are and how much work to do.
-pub struct EvalContext {
-    /// The workspace root (where `Cargo.toml` and `docs/` are).
-    pub workspace_root: PathBuf,
-    /// The data directory (`RAYPATH_DATA`, default `datasets/`).
-    pub data_dir: PathBuf,
-    /// Smaller workloads for CI and first runs.
-    pub quick: bool,
-    /// Where the outputs go: `docs/results/`, `target/eval/` (and shards) under it. The
-    /// workspace root, or `RAYPATH_EVAL_OUT` when set (tests and cluster runs that must not
-    /// write into the checkout; the README's headline table is then left alone).
-    pub out_dir: PathBuf,
-}
-
-impl EvalContext {
-    /// A quick context rooted at a scratch directory `root` (tests): data under `root/data`,
-    /// outputs under `root`.
-    #[cfg(test)]
-    pub fn scratch(root: &Path) -> Self {
-        Self {
-            workspace_root: root.to_path_buf(),
-            data_dir: root.join("data"),
-            quick: true,
-            out_dir: root.to_path_buf(),
-        }
-    }
-
-    /// A progress bar for `len` steps, drawn on stderr (hidden when stderr is not a terminal).
-    pub fn progress(&self, len: u64, message: &str) -> ProgressBar {
-        let bar = ProgressBar::new(len);
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{msg:>14} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta})",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-        );
-        bar.set_message(message.to_owned());
-        bar
-    }
-
-    /// Path of a data file, relative to the data directory.
-    pub fn data(&self, relative: &str) -> PathBuf {
-        self.data_dir.join(relative)
-    }
-
-    /// The semi-synthetic KITTI drive of `kitti-poles/<sequence>` (its real trajectory, times
-    /// and pole map) cut to its first `max_scans` scans (`None`: all); `None` when the
-    /// directory is absent.
-    pub fn semi_kitti_config(
-        &self,
-        sequence: &str,
-        max_scans: Option<usize>,
-    ) -> Result<Option<raypath_sim::semi_kitti::SemiKittiConfig>> {
-        let dir = self.data(&format!("kitti-poles/{sequence}"));
-        if !dir.join("poses.txt").is_file() || !dir.join("poles.csv").is_file() {
-            return Ok(None);
-        }
-        let mut config = raypath_sim::semi_kitti::SemiKittiConfig::from_files(
-            &dir.join("poses.txt"),
-            &dir.join("times.txt"),
-            &dir.join("poles.csv"),
-        )
-        .with_context(|| format!("reading {}", dir.display()))?;
-        config.sequence = sequence.to_owned();
-        config.max_scans = max_scans;
-        Ok(Some(config))
-    }
-
-    /// Where an evaluation may write pictures that belong to its report
-    /// (`docs/results/<name>/`), created on demand.
-    pub fn figure_dir(&self, name: &str) -> Result<PathBuf> {
-        let dir = self.out_dir.join("docs/results").join(name);
-        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-        Ok(dir)
-    }
-}
-
-/// The result of one evaluation.
-pub struct EvalReport {
-    /// Short name (`io`, `geometry`, …): file names and `cargo xtask eval <name>`.
-    pub name: &'static str,
-    /// A one-line title.
-    pub title: String,
-    /// The markdown body: tables beside the thesis figures, notes on what is real and what is
-    /// simulated.
-    pub markdown: String,
-    /// Machine-readable results.
-    pub json: serde_json::Value,
-    /// The run's figures in one line, real rows first (simulated ones named so): written at
-    /// the top of the results page and, after a full run, into the README's headline table
-    /// ([`crate::readme`]).
-    pub headline: Option<String>,
-}
-
-/// The SLAM benchmark's raw logs that have a corrected log in the data set: name, raw log,
-/// corrected log (under the data directory).
-pub(crate) const BENCHMARK_LOGS: [(&str, &str, &str); 3] = [
-    (
-        "intel",
-        "carmen/raw/intel.clf.bz2",
-        "carmen/corrected/intel-corrected.log.gz",
-    ),
-    (
-        "fr079",
-        "carmen/raw/fr079.clf.bz2",
-        "carmen/corrected/freiburg-079-corrected.log.gz",
-    ),
-    (
-        "mit-csail",
-        "carmen/raw/mit-csail.clf.bz2",
-        "carmen/corrected/csail-corrected.log.gz",
-    ),
-];
+pub(crate) use crate::stats::median;
+pub(crate) use context::{BENCHMARK_LOGS, context};
+pub use context::{EvalContext, data_dir, workspace_root};
+pub use report::EvalReport;
+use report::write_report;
 
 /// How an evaluation runs: one function, or in stages (then `--shard` and `merge` work).
 enum Runner {
@@ -295,19 +189,6 @@ fn staged(name: &str) -> Result<&'static stages::Staged> {
         })
 }
 
-fn context(quick: bool) -> EvalContext {
-    let out_dir = match std::env::var_os("RAYPATH_EVAL_OUT") {
-        Some(dir) if !dir.is_empty() => PathBuf::from(dir),
-        _ => workspace_root(),
-    };
-    EvalContext {
-        workspace_root: workspace_root(),
-        data_dir: data_dir(),
-        quick,
-        out_dir,
-    }
-}
-
 /// `cargo xtask eval <name> --shard i/n`: the shard's units, written to
 /// `target/eval/shards/<name>/`.
 pub fn run_shard(name: &str, quick: bool, shard: stages::Shard) -> Result<()> {
@@ -365,123 +246,4 @@ pub fn run(name: &str, quick: bool) -> Result<()> {
         bail!("evaluations failed: {}", failures.join(", "));
     }
     Ok(())
-}
-
-fn write_report(ctx: &EvalContext, report: &EvalReport, seconds: f64) -> Result<()> {
-    let command = format!(
-        "cargo xtask eval {}{}",
-        report.name,
-        if ctx.quick { " --quick" } else { "" }
-    );
-    let header = format!(
-        "# {}\n\n<!-- Written by `{command}`; do not edit by hand. -->\n\n\
-         - Command: `{command}`\n- Date (UTC): {}\n- Machine: {}\n- Data: `{}`\n- Run time: {seconds:.1} s\n\n",
-        report.title,
-        utc_date(),
-        machine(),
-        ctx.data_dir.display(),
-    );
-    let headline = match &report.headline {
-        Some(text) if ctx.quick => format!("**Headline (quick run).** {text}\n\n"),
-        Some(text) => format!("{}{text}\n\n", crate::readme::PREFIX),
-        None => String::new(),
-    };
-    let markdown = format!("{header}{headline}{}", report.markdown.trim_end());
-    println!("{markdown}\n");
-
-    let docs = ctx.out_dir.join("docs/results");
-    std::fs::create_dir_all(&docs)?;
-    let md_path = docs.join(format!("{}.md", report.name));
-    std::fs::write(&md_path, format!("{markdown}\n"))
-        .with_context(|| format!("writing {}", md_path.display()))?;
-
-    let json_dir = ctx.out_dir.join("target/eval");
-    std::fs::create_dir_all(&json_dir)?;
-    let json_path = json_dir.join(format!("{}.json", report.name));
-    let json = serde_json::json!({
-        "name": report.name,
-        "title": report.title,
-        "command": command,
-        "quick": ctx.quick,
-        "date_utc": utc_date(),
-        "machine": machine(),
-        "data_dir": ctx.data_dir.display().to_string(),
-        "seconds": seconds,
-        "results": report.json,
-    });
-    std::fs::write(&json_path, serde_json::to_string_pretty(&json)?)
-        .with_context(|| format!("writing {}", json_path.display()))?;
-    eprintln!("wrote {} and {}", md_path.display(), json_path.display());
-    if report.headline.is_some() && !ctx.quick && ctx.out_dir == ctx.workspace_root {
-        crate::readme::update(&ctx.workspace_root)?;
-    }
-    Ok(())
-}
-
-/// The workspace root: the parent of the xtask crate.
-pub fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .map(Path::to_path_buf)
-        .unwrap_or_else(|| PathBuf::from("."))
-}
-
-/// `RAYPATH_DATA`, or `datasets/` in the workspace.
-pub fn data_dir() -> PathBuf {
-    match std::env::var_os("RAYPATH_DATA") {
-        Some(dir) if !dir.is_empty() => {
-            let dir = PathBuf::from(dir);
-            std::fs::canonicalize(&dir).unwrap_or(dir)
-        }
-        _ => workspace_root().join("datasets"),
-    }
-}
-
-/// CPU model and core count, for report headers.
-pub fn machine() -> String {
-    let cpu = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|info| {
-            info.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split(':').nth(1))
-                .map(|m| m.trim().to_owned())
-        })
-        .unwrap_or_else(|| std::env::consts::ARCH.to_owned());
-    let cores = std::thread::available_parallelism().map_or(1, usize::from);
-    format!("{cpu}, {cores} cores available")
-}
-
-/// Today's date in UTC as `YYYY-MM-DD HH:MM`.
-pub fn utc_date() -> String {
-    let secs = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_secs());
-    let days = (secs / 86_400) as i64;
-    let (hour, minute) = ((secs % 86_400) / 3600, (secs % 3600) / 60);
-    // Civil-from-days (Howard Hinnant's algorithm).
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let day = doy - (153 * mp + 2) / 5 + 1;
-    let month = if mp < 10 { mp + 3 } else { mp - 9 };
-    let year = yoe + era * 400 + i64::from(month <= 2);
-    format!("{year:04}-{month:02}-{day:02} {hour:02}:{minute:02}")
-}
-
-/// Median of a slice (sorted in place); NaN for none.
-pub fn median(values: &mut [f64]) -> f64 {
-    if values.is_empty() {
-        return f64::NAN;
-    }
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    if n % 2 == 1 {
-        values[n / 2]
-    } else {
-        0.5 * (values[n / 2 - 1] + values[n / 2])
-    }
 }
