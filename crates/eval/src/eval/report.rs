@@ -23,6 +23,31 @@ pub struct EvalReport {
     pub headline: Option<String>,
 }
 
+/// `target/eval/<name>.json`: the run (what, when, where, how long) and the evaluation's own
+/// results. The fields are in alphabetical order, the order the keys have always been written
+/// in.
+#[derive(serde::Serialize)]
+struct ResultsFile<'a> {
+    /// `cargo xtask eval <name>[ --quick]`.
+    command: &'a str,
+    /// The data directory.
+    data_dir: String,
+    /// `YYYY-MM-DD HH:MM`, UTC.
+    date_utc: String,
+    /// CPU model and cores available.
+    machine: String,
+    /// The evaluation's name.
+    name: &'a str,
+    /// Whether this was a quick run.
+    quick: bool,
+    /// [`EvalReport::json`].
+    results: &'a serde_json::Value,
+    /// Run time (for a merge: the shards' sum).
+    seconds: f64,
+    /// [`EvalReport::title`].
+    title: &'a str,
+}
+
 /// Prints the report and writes its page and JSON (and, after a full run with a headline
 /// written into the checkout, the README's headline table).
 pub(crate) fn write_report(ctx: &EvalContext, report: &EvalReport, seconds: f64) -> Result<()> {
@@ -56,17 +81,17 @@ pub(crate) fn write_report(ctx: &EvalContext, report: &EvalReport, seconds: f64)
     let json_dir = ctx.out_dir.join("target/eval");
     std::fs::create_dir_all(&json_dir)?;
     let json_path = json_dir.join(format!("{}.json", report.name));
-    let json = serde_json::json!({
-        "name": report.name,
-        "title": report.title,
-        "command": command,
-        "quick": ctx.quick,
-        "date_utc": utc_date(),
-        "machine": machine(),
-        "data_dir": ctx.data_dir.display().to_string(),
-        "seconds": seconds,
-        "results": report.json,
-    });
+    let json = ResultsFile {
+        command: &command,
+        data_dir: ctx.data_dir.display().to_string(),
+        date_utc: utc_date(),
+        machine: machine(),
+        name: report.name,
+        quick: ctx.quick,
+        results: &report.json,
+        seconds,
+        title: &report.title,
+    };
     std::fs::write(&json_path, serde_json::to_string_pretty(&json)?)
         .with_context(|| format!("writing {}", json_path.display()))?;
     eprintln!("wrote {} and {}", md_path.display(), json_path.display());
