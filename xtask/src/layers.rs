@@ -9,10 +9,11 @@
 //! The crate graph drawn on the page (lines `crate ──► dep, dep`, or `──► every library crate
 //! below`) must list every crate with exactly its dependencies.
 //!
-//! Library crates (every workspace crate but the `raypath` program and xtask) do not print:
-//! no `println!`, `eprintln!`, `print!`, `eprint!` or `dbg!` in their `src/` outside comments,
-//! test modules (`#[cfg(test)] mod …`, `tests.rs`, `tests/`) and [`PRINT_ALLOWED`]. Their
-//! warnings are values and go through the `log` facade; the program and xtask print them.
+//! Library crates (every workspace crate but the `raypath` program, xtask and the evaluations
+//! it runs, `raypath-eval`) do not print: no `println!`, `eprintln!`, `print!`, `eprint!` or
+//! `dbg!` in their `src/` outside comments, test modules (`#[cfg(test)] mod …`, `tests.rs`,
+//! `tests/`) and [`PRINT_ALLOWED`]. Their warnings are values and go through the `log` facade;
+//! the program and xtask print them.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -30,12 +31,14 @@ const LAYERS: [&str; 6] = [
     "tooling",
 ];
 
-/// The crates that may print: the program and the developer tool.
-const PRINTING_CRATES: [&str; 2] = ["raypath-cli", "xtask"];
+/// The crates that may print: the program, the developer tool and the evaluations it runs
+/// (progress bars and the tables of a run).
+const PRINTING_CRATES: [&str; 3] = ["raypath-cli", "xtask", "raypath-eval"];
 
 /// The crates that face users and are no library other crates build on: the program, the
-/// developer tool and the Python package (which prints nothing).
-const APPLICATIONS: [&str; 3] = ["raypath-cli", "xtask", "raypath-python"];
+/// developer tool, the evaluations (a library only xtask calls) and the Python package (which
+/// prints nothing).
+const APPLICATIONS: [&str; 4] = ["raypath-cli", "xtask", "raypath-eval", "raypath-python"];
 
 /// The printing macros a library crate may not call.
 const PRINT_MACROS: [&str; 5] = ["println", "eprintln", "print", "eprint", "dbg"];

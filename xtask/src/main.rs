@@ -1,4 +1,6 @@
-//! `cargo xtask`: raypath's evaluations, dataset checks and the fuzz run of the file readers.
+//! `cargo xtask`: the developer tool. The command line of raypath's evaluations, data-set
+//! checks and README table (all in `raypath-eval`, crates/eval), the fuzz run of the file
+//! readers ([`fuzz`]) and the layer check ([`layers`]).
 //!
 //! ```text
 //! cargo xtask eval <name>|all [--quick]   run evaluations, print tables, write docs/results/
@@ -18,15 +20,8 @@
 //!                                         results pages
 //! ```
 
-mod datasets;
-mod eval;
 mod fuzz;
-mod generate;
 mod layers;
-mod readme;
-mod render;
-mod stats;
-mod table;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -54,7 +49,7 @@ enum Command {
         /// to `target/eval/shards/<name>/`; `eval merge <name>` writes the report. For the
         /// evaluations written in stages (an error names them).
         #[arg(long, value_name = "I/N")]
-        shard: Option<eval::stages::Shard>,
+        shard: Option<raypath_eval::Shard>,
     },
     /// List the data sets found under RAYPATH_DATA and the ones missing, with where to get them;
     /// `datasets generate` writes the simulated sets under datasets/generated/.
@@ -138,25 +133,25 @@ fn main() -> Result<()> {
             quick,
             shard,
         } => match (name.as_str(), merged, shard) {
-            ("merge", Some(target), None) => eval::merge(&target, quick),
+            ("merge", Some(target), None) => raypath_eval::merge(&target, quick),
             ("merge", None, _) => anyhow::bail!("eval merge <name>: name the evaluation"),
-            (_, None, Some(shard)) => eval::run_shard(&name, quick, shard),
-            (_, None, None) => eval::run(&name, quick),
+            (_, None, Some(shard)) => raypath_eval::run_shard(&name, quick, shard),
+            (_, None, None) => raypath_eval::run(&name, quick),
             (_, Some(extra), _) => anyhow::bail!("eval {name}: unexpected argument {extra:?}"),
         },
         Command::Datasets { json, action } => match action {
-            None => datasets::run(json),
+            None => raypath_eval::list_datasets(json),
             Some(DatasetsAction::Generate { quick, only, seed }) => {
-                generate::run(quick, only.as_deref(), seed)
+                raypath_eval::generate_datasets(quick, only.as_deref(), seed)
             }
         },
         Command::Fuzz(options) => fuzz::run(&options),
-        Command::MemoryProbe { workload, quick } => eval::memory::probe(&workload, quick),
+        Command::MemoryProbe { workload, quick } => raypath_eval::memory_probe(&workload, quick),
         Command::CheckLayers => {
             layers::run(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
         }
-        Command::Readme => {
-            readme::update(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        }
+        Command::Readme => raypath_eval::readme::update(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".."),
+        ),
     }
 }

@@ -8,7 +8,7 @@ use raypath_dct_map::experiment::{GroundTruth, compare, draw_rays, seeded_patch}
 use raypath_dct_map::{FitConfig, FitProblem, MapRay, RangeLimits, Shape, fit, initial_map};
 use raypath_io::sequence::{LaserChoice, PlanarOptions, read_planar};
 
-/// The eval's patch and ray split (xtask/src/eval/dct.rs: 10 m patch among those with at
+/// The eval's patch and ray split (crates/eval/src/eval/dct.rs: 10 m patch among those with at
 /// least 75 % of the heaviest weight, seed 9, 10⁴ mapping and 500 held-back rays).
 fn csail_patch() -> Option<([f64; 2], Vec<MapRay>, Vec<MapRay>)> {
     let path = raypath_io::data::require("carmen/corrected/csail-corrected.log.gz")?;

@@ -46,8 +46,8 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 
-use crate::eval::workspace_root;
-use crate::table::Table;
+use raypath_eval::table::Table;
+use raypath_eval::workspace_root;
 use targets::{Input, Target, Verdict};
 
 /// Cases per reader unless `--cases` says otherwise.

@@ -40,6 +40,20 @@ pub fn paired_greater(a: &[f64], b: &[f64]) -> f64 {
     paired_less(b, a)
 }
 
+/// Median of a slice (sorted in place); NaN for none.
+pub fn median(values: &mut [f64]) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -7,7 +7,7 @@
 //!   drive (raypath-sim `urban-kitti`, HDL-64E) and scans simulated inside the real building
 //!   map `octomap/geb079.bt`. Every data set is written as an OctoMap `.graph` (raypath-io)
 //!   and read by both sides.
-//! * OctoMap 1.9 (the installed liboctomap) through `xtask/octomap/driver.cpp`, built with
+//! * OctoMap 1.9 (the installed liboctomap) through `crates/eval/octomap/driver.cpp`, built with
 //!   `g++ -O2` into `target/octomap-driver`: `insertPointCloud` (beam-based) or the
 //!   de-duplicated end points (beam-end-point), then `prune()`, `memoryUsage()`, the leaf
 //!   iterator for the occupied-cell access time and `search()` for the classification of
@@ -195,7 +195,7 @@ fn intro(sets: &[&SetInfo], unavailable: Option<&str>) -> Result<String> {
         None => writeln!(
             md,
             "OctoMap: the installed liboctomap (Debian `liboctomap-dev`, 1.9.x) through \
-             `xtask/octomap/driver.cpp`; leaves and inner nodes after `prune()`, bytes from \
+             `crates/eval/octomap/driver.cpp`; leaves and inner nodes after `prune()`, bytes from \
              `memoryUsage()`. Both sides single-threaded, run one after the other on a machine \
              shared with other jobs (absolute times are under load; the ratios are the result).\n"
         )?,

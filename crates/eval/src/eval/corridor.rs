@@ -550,7 +550,7 @@ mod tests {
         assert_eq!(a.rho, b.rho);
     }
 
-    /// Prints the quick section (`cargo test -p xtask corridor -- --ignored --nocapture`; the
+    /// Prints the quick section (`cargo test -p raypath-eval corridor -- --ignored --nocapture`; the
     /// full one with `CORRIDOR_FULL=1`).
     #[test]
     #[ignore = "prints the quick corridor table (a few seconds)"]

@@ -533,7 +533,7 @@ mod tests {
     #[test]
     fn reports_without_data() {
         let ctx = EvalContext {
-            workspace_root: std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(".."),
+            workspace_root: std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../.."),
             data_dir: std::env::temp_dir().join("raypath-registration-test-absent-data"),
             quick: true,
             out_dir: crate::eval::workspace_root(),

@@ -249,6 +249,53 @@ struct Case {
     naive: Timing,
 }
 
+/// `results` of `target/eval/geometry.json` (keys as the fields; a JSON object's keys are
+/// written sorted).
+#[derive(serde::Serialize)]
+struct GeometryResults {
+    repetitions: usize,
+    aim_3d_cells_per_sec: f64,
+    load_average_before: Option<f64>,
+    load_average_after: Option<f64>,
+    cases: Vec<CaseResult>,
+}
+
+/// One workload of [`GeometryResults`]: medians of the fast and the naive traversal.
+#[derive(serde::Serialize)]
+struct CaseResult {
+    case: &'static str,
+    grid: &'static str,
+    rays: usize,
+    cells: usize,
+    traced_length_m: f64,
+    median_cells_per_sec_wall: f64,
+    median_cells_per_sec_cpu: f64,
+    wall_secs_per_pass: Vec<f64>,
+    naive_cells: usize,
+    naive_median_cells_per_sec_wall: f64,
+    naive_median_cells_per_sec_cpu: f64,
+    naive_wall_secs_per_pass: Vec<f64>,
+}
+
+impl CaseResult {
+    fn of(case: &Case) -> Self {
+        Self {
+            case: case.name,
+            grid: case.grid,
+            rays: case.rays,
+            cells: case.fast.cells,
+            traced_length_m: case.fast.length_m,
+            median_cells_per_sec_wall: case.fast.wall_cells_per_sec,
+            median_cells_per_sec_cpu: case.fast.cpu_cells_per_sec,
+            wall_secs_per_pass: case.fast.wall_secs.clone(),
+            naive_cells: case.naive.cells,
+            naive_median_cells_per_sec_wall: case.naive.wall_cells_per_sec,
+            naive_median_cells_per_sec_cpu: case.naive.cpu_cells_per_sec,
+            naive_wall_secs_per_pass: case.naive.wall_secs.clone(),
+        }
+    }
+}
+
 /// Runs the evaluation.
 pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
     let rays_per_case = if ctx.quick { 10_000 } else { 100_000 };
@@ -411,36 +458,18 @@ fn report(cases: &[Case], conditions: &Conditions) -> Result<EvalReport> {
         after = fmt_load(load_after),
     );
 
-    let json_cases: Vec<_> = cases
-        .iter()
-        .map(|case| {
-            serde_json::json!({
-                "case": case.name,
-                "grid": case.grid,
-                "rays": case.rays,
-                "cells": case.fast.cells,
-                "traced_length_m": case.fast.length_m,
-                "median_cells_per_sec_wall": case.fast.wall_cells_per_sec,
-                "median_cells_per_sec_cpu": case.fast.cpu_cells_per_sec,
-                "wall_secs_per_pass": case.fast.wall_secs,
-                "naive_cells": case.naive.cells,
-                "naive_median_cells_per_sec_wall": case.naive.wall_cells_per_sec,
-                "naive_median_cells_per_sec_cpu": case.naive.cpu_cells_per_sec,
-                "naive_wall_secs_per_pass": case.naive.wall_secs,
-            })
-        })
-        .collect();
+    let results = GeometryResults {
+        repetitions,
+        aim_3d_cells_per_sec: AIM_3D_CELLS_PER_SEC,
+        load_average_before: load_before,
+        load_average_after: load_after,
+        cases: cases.iter().map(CaseResult::of).collect(),
+    };
     Ok(EvalReport {
         name: "geometry",
         title: "Exact ray traversal throughput (cells per second, one core)".to_owned(),
         markdown,
-        json: serde_json::json!({
-            "repetitions": repetitions,
-            "aim_3d_cells_per_sec": AIM_3D_CELLS_PER_SEC,
-            "load_average_before": load_before,
-            "load_average_after": load_after,
-            "cases": json_cases,
-        }),
+        json: serde_json::to_value(&results)?,
         headline: None,
     })
 }

@@ -1,4 +1,4 @@
-//! The OctoMap side: builds `xtask/octomap/driver.cpp` against the installed liboctomap and
+//! The OctoMap side: builds `crates/eval/octomap/driver.cpp` against the installed liboctomap and
 //! runs it on a `.graph` file.
 
 use std::path::{Path, PathBuf};
@@ -40,7 +40,7 @@ pub struct PeerRun {
 /// Builds the driver into `target/octomap-driver` (rebuilt when the source is newer), or
 /// explains why OctoMap is unavailable.
 pub fn build(root: &Path) -> Result<PathBuf, String> {
-    let source = root.join("xtask/octomap/driver.cpp");
+    let source = root.join("crates/eval/octomap/driver.cpp");
     let binary = root.join("target/octomap-driver");
     if !Path::new("/usr/include/octomap/OcTree.h").exists() {
         return Err(

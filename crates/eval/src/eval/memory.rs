@@ -236,7 +236,7 @@ pub fn run(ctx: &EvalContext) -> Result<EvalReport> {
          of its own: `input loaded` is the peak after reading the input, before the \
          workload; `structure` is the data structure's own size (our grid's \
          `stats().bytes`, OctoMap's `memoryUsage()` after `prune()`). OctoMap runs in its \
-         driver (`xtask/octomap/driver.cpp`, liboctomap 1.9) on the same `.graph` file, \
+         driver (`crates/eval/octomap/driver.cpp`, liboctomap 1.9) on the same `.graph` file, \
          beam-based, r = 0.2 m, the same sensor model; our grid: r = 0.2 m, M = 8. The \
          processes differ (Rust binary with every evaluation linked vs a small C++ driver), \
          so the peaks include different fixed costs; the structure columns compare the maps \
