@@ -83,7 +83,7 @@ impl SlamOutput {
     /// pose at its scan's own time stamp ([`ScanPose::stamp_secs`]: the sensor's time), so
     /// `evo` and the SLAM benchmark's relation files join on it.
     pub fn tum(&self) -> String {
-        raypath_reflectivity::export::tum_lines(
+        raypath_io::tum::planar_tum_lines(
             self.scans
                 .iter()
                 .zip(&self.world_from_sensor)

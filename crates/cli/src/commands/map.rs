@@ -137,7 +137,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let mut recording = Recording::open(&args.record)?;
     let report = build(args, recording.as_mut())?;
     if super::console::json() {
-        let mut doc = serde_json::to_value(&report).map_err(Failure::internal)?;
+        let mut doc = super::to_json(&report)?;
         super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
     } else {

@@ -192,7 +192,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         record(recording, &frames, &output, &map_file, args.model)?;
     }
     if super::console::json() {
-        let mut doc = serde_json::to_value(&report).map_err(Failure::internal)?;
+        let mut doc = super::to_json(&report)?;
         super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
     } else {
