@@ -52,6 +52,12 @@ struct ErrorReport<'a> {
     error: &'a str,
 }
 
+/// Prints `{"error": message}` (the `--json` answer of a failure).
+pub fn print_error_json(message: &str) {
+    let doc = ErrorReport { error: message };
+    println!("{}", serde_json::to_value(&doc).unwrap_or_default());
+}
+
 /// Why a subcommand failed, and how to report it.
 pub struct Failure {
     /// The message (for input errors: `file:place: reason`).
@@ -82,10 +88,7 @@ impl Failure {
     pub fn report(&self) -> ExitCode {
         eprintln!("error: {}", self.message);
         if console::json() {
-            let doc = ErrorReport {
-                error: &self.message,
-            };
-            println!("{}", serde_json::to_value(&doc).unwrap_or_default());
+            print_error_json(&self.message);
         }
         ExitCode::from(if self.bad_input { 2 } else { 1 })
     }
