@@ -168,7 +168,7 @@ fn parse_failure(error: &clap::Error) -> ExitCode {
             .collect();
         let message = message.join(" ");
         let message = message.trim_start_matches("error: ");
-        println!("{}", serde_json::json!({ "error": message }));
+        commands::print_error_json(message);
     }
     ExitCode::from(2)
 }

@@ -5,9 +5,10 @@ use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use raypath_geometry::Pose3;
+use raypath_geometry::{Pose2, Pose3};
 
 use crate::Result;
+use crate::error::{Error, Location};
 use crate::source::{LineReader, finite_fields};
 
 /// One stamped pose of a TUM trajectory.
@@ -52,6 +53,37 @@ fn tum_from(mut lines: LineReader) -> Result<Vec<TumPose>> {
         });
     }
     Ok(poses)
+}
+
+/// Planar poses with their time stamps as TUM lines (`t x y z qx qy qz qw`: z = 0 and a yaw
+/// quaternion; `t x y` with six decimals, the quaternion with nine). The one TUM writer of
+/// the workspace: `raypath slam`, `scan-match` and `localize` write through it.
+pub fn planar_tum_lines(stamped: impl IntoIterator<Item = (f64, Pose2)>) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    for (t, p) in stamped {
+        let half = p.theta() / 2.0;
+        let _ = writeln!(
+            out,
+            "{t:.6} {:.6} {:.6} 0 0 0 {:.9} {:.9}",
+            p.x(),
+            p.y(),
+            half.sin(),
+            half.cos()
+        );
+    }
+    out
+}
+
+/// Writes [`planar_tum_lines`] to `path`, after `# comment` when one is given.
+pub fn write_planar_tum(
+    path: &Path,
+    comment: Option<&str>,
+    stamped: impl IntoIterator<Item = (f64, Pose2)>,
+) -> Result<()> {
+    let mut text = comment.map_or_else(String::new, |c| format!("# {c}\n"));
+    text.push_str(&planar_tum_lines(stamped));
+    std::fs::write(path, text).map_err(|e| Error::io(path, Location::File, e))
 }
 
 #[cfg(test)]

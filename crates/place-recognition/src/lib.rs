@@ -154,6 +154,7 @@ mod shot;
 // Precision–recall, online loop acceptance and the runners (Khan 2017, §4.5.3).
 mod online;
 mod pr;
+pub mod report;
 mod run;
 
 // The geometric check of candidates on planar scans (ours).

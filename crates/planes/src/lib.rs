@@ -64,6 +64,7 @@ mod msac;
 mod params;
 mod peac;
 mod ppe;
+pub mod report;
 mod stats;
 #[cfg(test)]
 mod test_scenes;

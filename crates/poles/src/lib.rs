@@ -131,6 +131,7 @@ mod params;
 mod pipeline;
 mod pole;
 mod reference;
+pub mod report;
 mod score;
 mod sweep;
 

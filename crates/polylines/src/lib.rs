@@ -118,6 +118,7 @@ mod optimize;
 mod ple;
 mod polyline;
 mod rays;
+pub mod report;
 #[cfg(feature = "svg")]
 pub mod svg;
 

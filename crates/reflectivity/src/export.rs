@@ -13,8 +13,6 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use raypath_geometry::Pose2;
-
 use crate::error::{ReflectivityError, Result};
 use crate::grid::{GridLevel, probability};
 
@@ -118,21 +116,4 @@ pub fn write_reflectivity_png(level: &GridLevel, path: &Path) -> Result<bool> {
     }
     img.save(path).map_err(|e| io_error(path, e))?;
     Ok(true)
-}
-
-/// Formats poses with their timestamps as TUM trajectory lines.
-pub fn tum_lines(stamped: impl IntoIterator<Item = (f64, Pose2)>) -> String {
-    let mut out = String::new();
-    for (t, p) in stamped {
-        let half = p.theta() / 2.0;
-        let _ = writeln!(
-            out,
-            "{t:.6} {:.6} {:.6} 0 0 0 {:.9} {:.9}",
-            p.x(),
-            p.y(),
-            half.sin(),
-            half.cos()
-        );
-    }
-    out
 }

@@ -98,6 +98,7 @@ mod local_map;
 mod normals;
 mod odometry;
 mod preprocess;
+pub mod report;
 mod target;
 
 pub use adaptive::AdaptiveThreshold;

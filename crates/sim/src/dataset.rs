@@ -1,6 +1,6 @@
 //! What every data-set generator returns and how it reports progress.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
@@ -11,6 +11,21 @@ pub type Progress<'a> = &'a (dyn Fn(u64, u64) + Sync);
 /// A progress callback that ignores all reports.
 pub fn no_progress() -> Progress<'static> {
     &|_, _| {}
+}
+
+/// The manifest at the root of a generated set (seed, mode, files, statistics), written by
+/// `cargo xtask datasets generate`.
+pub const SET_MANIFEST: &str = "set.json";
+
+/// Whether the sequence directory `sequence` belongs to a generated set: `<set>/sequences/NN`
+/// (or `<set>/NN`) with the [`SET_MANIFEST`] in `<set>`. Such KITTI-layout scans are measured
+/// from one pose, not de-skewed sweeps.
+pub fn in_generated_set(sequence: &Path) -> bool {
+    sequence
+        .ancestors()
+        .skip(1)
+        .take(2)
+        .any(|dir| dir.join(SET_MANIFEST).is_file())
 }
 
 /// What a generator wrote.

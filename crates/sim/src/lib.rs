@@ -68,5 +68,5 @@ pub mod semi_nclt;
 pub mod synpeb;
 pub mod urban;
 
-pub use dataset::{GeneratedSet, Progress, no_progress};
+pub use dataset::{GeneratedSet, Progress, SET_MANIFEST, in_generated_set, no_progress};
 pub use error::{Result, SimError};

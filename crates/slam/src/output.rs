@@ -8,7 +8,8 @@ use raypath_io::sequence::PlanarFrame;
 
 use crate::error::{Result, SlamError};
 use crate::graph::PoseGraph;
-use crate::loops::{LoopClosure, LoopStats};
+use crate::loops::{LoopClosure, LoopSource, LoopStats};
+use crate::report::SlamFiles;
 use crate::submap::Submap;
 
 /// One processed scan.
@@ -82,7 +83,7 @@ impl SlamOutput {
     /// pose at its scan's own time stamp ([`ScanPose::stamp_secs`]: the sensor's time), so
     /// `evo` and the SLAM benchmark's relation files join on it.
     pub fn tum(&self) -> String {
-        raypath_reflectivity::export::tum_lines(
+        raypath_io::tum::planar_tum_lines(
             self.scans
                 .iter()
                 .zip(&self.world_from_sensor)
@@ -125,5 +126,51 @@ impl SlamOutput {
     pub fn write_corrected_log(&self, frames: &[PlanarFrame], path: &Path) -> Result<()> {
         raypath_io::convert::write_carmen(path, &self.corrected_frames(frames)?)?;
         Ok(())
+    }
+
+    /// The accepted loop closures as CSV, one per line under the header
+    /// `scan,anchor_scan,node,submap,x,y,theta,score,source` (`x y theta`: the scan's sensor
+    /// in the submap's frame; `source`: `nearby`, `place-recognition` or `global`).
+    pub fn loop_closures_csv(&self) -> String {
+        let mut text = String::from("scan,anchor_scan,node,submap,x,y,theta,score,source\n");
+        for c in &self.loop_closures {
+            let scan = self.node_scan.get(c.node).copied().unwrap_or(usize::MAX);
+            let anchor = self.node_scan.get(c.anchor).copied().unwrap_or(usize::MAX);
+            let p = c.submap_from_sensor;
+            let source = match c.source {
+                LoopSource::Nearby => "nearby",
+                LoopSource::PlaceRecognition => "place-recognition",
+                LoopSource::Global => "global",
+            };
+            text.push_str(&format!(
+                "{scan},{anchor},{},{},{},{},{},{},{source}\n",
+                c.node,
+                c.submap,
+                p.x(),
+                p.y(),
+                p.theta(),
+                c.score
+            ));
+        }
+        text
+    }
+
+    /// Writes the run's files into the directory `dir` (which must exist): `trajectory.txt`
+    /// ([`Self::tum`]), `corrected.log` ([`Self::write_corrected_log`] of `frames`) and
+    /// `loop_closures.csv` ([`Self::loop_closures_csv`]).
+    pub fn write_files(&self, dir: &Path, frames: &[PlanarFrame]) -> Result<SlamFiles> {
+        let trajectory = dir.join("trajectory.txt");
+        self.write_tum(&trajectory)?;
+        let corrected_log = dir.join("corrected.log");
+        self.write_corrected_log(frames, &corrected_log)?;
+        let loop_closures = dir.join("loop_closures.csv");
+        std::fs::write(&loop_closures, self.loop_closures_csv()).map_err(|e| {
+            SlamError::BadInput(format!("{}: cannot write: {e}", loop_closures.display()))
+        })?;
+        Ok(SlamFiles {
+            trajectory,
+            corrected_log,
+            loop_closures,
+        })
     }
 }

@@ -20,7 +20,6 @@
 //! (`/tf` `map → base_link`, `/scan` in `base_link`), the estimates as `/trajectory` and the
 //! ground truth as `/ground_truth`.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use raypath_geometry::Pose2;
@@ -29,13 +28,13 @@ use raypath_io::sequence::PlanarFrame;
 use raypath_localizer::eval::{EvaluationConfig, evaluate_trajectory};
 use raypath_localizer::init::GaussianInit;
 use raypath_localizer::lidar::{
-    LidarConfig, ModelKind, ModelSpec, PlanarStep, Scan2Measurement, TrackConfig, track_planar,
+    LidarConfig, LocalizeReport, ModelKind, ModelSpec, PlanarStep, Scan2Measurement, TrackConfig,
+    track_planar,
 };
 use raypath_localizer::{PoseTrack, Stamped};
 use raypath_sensor_models::DenseStats2;
 use raypath_sensor_models::OpticalDepthConfig;
 use raypath_sensor_models::export::{MapFile, MapKind, MapPicture, StoredStats, picture_values};
-use serde_json::json;
 
 use super::Failure;
 use super::record::{RecordArgs, Recording};
@@ -307,8 +306,12 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     super::console::stage("localization", started);
 
     if let Some(out) = &args.out {
-        write_tum(out, &result.estimates)
-            .map_err(|e| Failure::internal(format!("{}: {e}", out.display())))?;
+        raypath_io::tum::write_planar_tum(
+            out,
+            Some("raypath localize: t x y z qx qy qz qw (world_from_robot, map frame)"),
+            result.estimates.iter().map(|(_, s)| (s.stamp_secs, s.pose)),
+        )
+        .map_err(Failure::internal)?;
     }
     // With ground truth paired to scans, evaluate the estimates at those scans only: between
     // them both tracks are interpolated over the same stamps.
@@ -343,32 +346,20 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             truth,
         )?;
     }
-    let mut summary = json!({
-        "map": args.map.display().to_string(),
-        "log": args.log.display().to_string(),
-        "model": spec.label(),
-        "particles": args.particles,
-        "seed": args.seed,
-        "scans": steps.len(),
-        "updates": result.updates,
-        "failed_updates": result.failed_updates,
-        "resamplings": result.resamplings,
-        "final_pose": result.estimates.last().map(|(_, s)| [s.pose.x(), s.pose.y(), s.pose.theta()]),
-        "error": evaluation.as_ref().map(|e| json!({
-            "evaluated_points": e.points.len(),
-            "length_m": e.length_m,
-            "position_mean_m": e.position_m.mean_abs,
-            "position_rmse_m": e.position_m.rmse,
-            "heading_mean_rad": e.heading_rad.mean_abs,
-            "heading_rmse_rad": e.heading_rad.rmse,
-            "lateral_rmse_m": e.lateral_m.rmse,
-            "longitudinal_rmse_m": e.longitudinal_m.rmse,
-            "diverged": e.divergence.diverged(),
-            "divergence_episodes": e.divergence.episodes,
-            "divergence_fraction": e.divergence.fraction_of_time,
-        })),
-    });
+    let report = LocalizeReport::new(
+        (
+            args.map.display().to_string(),
+            args.log.display().to_string(),
+            spec.label(),
+        ),
+        args.particles,
+        args.seed,
+        steps.len(),
+        &result,
+        evaluation.as_ref(),
+    );
     if json {
+        let mut summary = super::to_json(&report)?;
         super::record::finish(recording, Some(&mut summary))?;
         println!("{summary:#}");
     } else {
@@ -445,25 +436,4 @@ fn record(
         recording.planar_trajectory(topic::GROUND_TRUTH, end, truth)?;
     }
     Ok(())
-}
-
-fn write_tum(path: &Path, estimates: &[(usize, Stamped<Pose2>)]) -> std::io::Result<()> {
-    let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(
-        out,
-        "# raypath localize: t x y z qx qy qz qw (world_from_robot, map frame)"
-    )?;
-    for (_, s) in estimates {
-        let half = s.pose.theta() / 2.0;
-        writeln!(
-            out,
-            "{:.6} {:.6} {:.6} 0 0 0 {:.9} {:.9}",
-            s.stamp_secs,
-            s.pose.x(),
-            s.pose.y(),
-            half.sin(),
-            half.cos()
-        )?;
-    }
-    out.flush()
 }

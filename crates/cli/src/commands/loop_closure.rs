@@ -62,6 +62,7 @@ use std::path::PathBuf;
 use nalgebra::Point3;
 use raypath_geometry::Pose3;
 use raypath_io::foxglove::{frame, topic};
+use raypath_place_recognition::report::LoopClosureReport;
 use raypath_place_recognition::{
     BinaryVocabulary, Candidate, Dbow, DbowConfig, Exclusion, FrameTiming, GeometricCheck,
     GeometricCheckConfig, GlobalDescriptorDb, GroundTruth, Ibuild, IbuildConfig, IbuildScore,
@@ -70,7 +71,6 @@ use raypath_place_recognition::{
     detect_and_describe, detect_loops, frame_image, kidnapped_pr, online_pr, run_kidnapped,
     run_online,
 };
-use serde_json::json;
 
 use self::input::{Input, read_input};
 use self::truth::{TruthParams, ground_truth};
@@ -299,7 +299,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         record(recording, &input, poses.unwrap_or_default(), &loops)?;
     }
     if super::console::json() {
-        let mut doc = to_json(&input, &outcome, &loops, summary.as_ref());
+        let mut doc = super::to_json(&report(&input, &outcome, &loops, summary.as_ref()))?;
         super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
     } else {
@@ -580,44 +580,21 @@ fn ms_per_query(outcome: &Outcome) -> f64 {
     FrameTiming::mean(&outcome.timings).total_s * 1e3
 }
 
-fn to_json(
+fn report(
     input: &Input,
     outcome: &Outcome,
     loops: &[LoopClosure],
     summary: Option<&PrSummary>,
-) -> serde_json::Value {
-    let label = |i: usize| input.labels.get(i).copied().unwrap_or(i);
-    let loops: Vec<_> = loops
-        .iter()
-        .map(|l| json!({"query": label(l.query), "match": label(l.matched), "score": l.score}))
-        .collect();
-    let candidates: Vec<_> = outcome
-        .candidates
-        .iter()
-        .enumerate()
-        .filter_map(|(i, list)| {
-            let best = list.first()?;
-            Some(json!({"query": label(i), "match": label(best.frame), "score": best.score}))
-        })
-        .collect();
-    let mut doc = json!({
-        "method": outcome.method,
-        "frames": input.len(),
-        "ms_per_query": ms_per_query(outcome),
-        "loops": loops,
-        "candidates": candidates,
-    });
-    if let (Some(s), Some(obj)) = (summary, doc.as_object_mut()) {
-        obj.insert(
-            "summary".into(),
-            json!({
-                "recall_at_100_precision": s.recall_at_100_precision,
-                "precision_at_100_recall": s.precision_at_100_recall,
-                "max_f1": s.max_f1,
-            }),
-        );
-    }
-    doc
+) -> LoopClosureReport {
+    LoopClosureReport::new(
+        outcome.method,
+        input.len(),
+        ms_per_query(outcome),
+        loops,
+        &outcome.candidates,
+        |i| input.labels.get(i).copied().unwrap_or(i),
+        summary.copied(),
+    )
 }
 
 fn print_text(

@@ -42,16 +42,13 @@
 mod input;
 pub(crate) mod record;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use raypath_sensor_models::export::{
-    MapFile, MapKind, MapPicture, RosMapOptions, StoredStats, picture_values, write_png,
-    write_ros_map,
+    MapFile, MapFiles, MapKind, MapPicture, MapReport, StoredStats, write_map_files,
 };
-use raypath_sensor_models::{
-    DenseStats2, DenseStats3, MappingConfig, MappingSummary, SparseStats3,
-};
+use raypath_sensor_models::{DenseStats2, DenseStats3, MappingConfig, SparseStats3};
 
 use super::Failure;
 use super::record::{RecordArgs, Recording};
@@ -70,15 +67,7 @@ pub enum Model {
 }
 
 impl Model {
-    fn name(self) -> &'static str {
-        match self {
-            Model::DecayRate => "decay-rate",
-            Model::Reflection => "reflection",
-            Model::LogOdds => "log-odds",
-        }
-    }
-
-    fn kind(self) -> MapKind {
+    pub(crate) fn kind(self) -> MapKind {
         match self {
             Model::DecayRate => MapKind::DecayRate,
             Model::Reflection => MapKind::Reflection,
@@ -148,23 +137,17 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let mut recording = Recording::open(&args.record)?;
     let report = build(args, recording.as_mut())?;
     if super::console::json() {
-        let mut doc = report.json();
+        let mut doc = super::to_json(&report)?;
         super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
     } else {
-        report.print();
+        print(&report);
         super::record::finish(recording, None)?;
     }
     Ok(())
 }
 
-/// Builds the map and writes its files without printing: the JSON object `raypath map --json`
-/// prints. `raypath slam` rebuilds its map from the optimised poses through this.
-pub fn build_json(args: &Args) -> Result<serde_json::Value, Failure> {
-    Ok(build(args, None)?.json())
-}
-
-fn build(args: &Args, recording: Option<&mut Recording>) -> Result<Report, Failure> {
+fn build(args: &Args, recording: Option<&mut Recording>) -> Result<MapReport, Failure> {
     let started = Instant::now();
     let config = check_args(args)?;
     let input =
@@ -172,7 +155,7 @@ fn build(args: &Args, recording: Option<&mut Recording>) -> Result<Report, Failu
     super::console::stage("reading", started);
     let mapping_started = Instant::now();
     let spinner = super::console::spinner("mapping");
-    let (stats, dims) = match &input {
+    let stats = match &input {
         Input::Planar { scans, bounds, .. } => {
             let grid = raypath_geometry::Grid2::covering(bounds, args.resolution)
                 .map_err(|e| grid_failure(args, e))?;
@@ -184,7 +167,7 @@ fn build(args: &Args, recording: Option<&mut Recording>) -> Result<Report, Failu
                     sink(&ray);
                 }
             });
-            (StoredStats::Planar(stats), 2)
+            StoredStats::Planar(stats)
         }
         Input::Spatial { sweeps, bounds, .. } => {
             let grid = raypath_geometry::Grid3::covering(bounds, args.resolution)
@@ -202,7 +185,7 @@ fn build(args: &Args, recording: Option<&mut Recording>) -> Result<Report, Failu
                 dense.insert_par(sweeps, &config, rays_of);
                 dense
             };
-            (StoredStats::Spatial(stats), 3)
+            StoredStats::Spatial(stats)
         }
     };
     spinner.finish_and_clear();
@@ -218,12 +201,11 @@ fn build(args: &Args, recording: Option<&mut Recording>) -> Result<Report, Failu
     if let Some(recording) = recording {
         record::record(recording, &input, &file, args.model.picture())?;
     }
-    Ok(Report::of(
-        args,
+    Ok(MapReport::new(
         &file,
-        dims,
+        args.resolution,
         mapping_secs,
-        started,
+        started.elapsed().as_secs_f64(),
         written,
     ))
 }
@@ -275,22 +257,7 @@ fn check_size(args: &Args, cells: usize) -> Result<(), Failure> {
     Ok(())
 }
 
-/// The files written.
-struct Written {
-    pgm: PathBuf,
-    yaml: PathBuf,
-    png: PathBuf,
-    rpmap: PathBuf,
-}
-
-fn with_suffix(prefix: &Path, suffix: &str) -> PathBuf {
-    let mut name = prefix.as_os_str().to_owned();
-    name.push(suffix);
-    PathBuf::from(name)
-}
-
-fn write_outputs(args: &Args, file: &MapFile) -> Result<Written, Failure> {
-    let failure = |e: raypath_sensor_models::SensorModelError| Failure::internal(e.to_string());
+fn write_outputs(args: &Args, file: &MapFile) -> Result<MapFiles, Failure> {
     if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| {
             Failure::internal(format!(
@@ -299,188 +266,51 @@ fn write_outputs(args: &Args, file: &MapFile) -> Result<Written, Failure> {
             ))
         })?;
     }
-    let projected;
-    let planar = match &file.stats {
-        StoredStats::Planar(stats) => stats,
-        StoredStats::Spatial(stats) => {
-            projected = stats.project_z();
-            &projected
-        }
+    write_map_files(&args.out, file, args.model.picture()).map_err(Failure::internal)
+}
+
+/// The human view of the report.
+fn print(report: &MapReport) {
+    let grid: Vec<String> = report.grid.iter().map(usize::to_string).collect();
+    let coords = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{x:.2}"))
+            .collect::<Vec<_>>()
+            .join(", ")
     };
-    let values = picture_values(planar, args.model.picture());
-    // `write_ros_map` replaces the extension; give it a name whose "extension" is ours.
-    let (pgm, yaml) = write_ros_map(
-        &with_suffix(&args.out, ".pgm"),
-        planar.grid(),
-        &values,
-        &RosMapOptions::default(),
-    )
-    .map_err(failure)?;
-    let png = with_suffix(&args.out, ".png");
-    write_png(&png, planar.grid(), &values).map_err(failure)?;
-    let rpmap = with_suffix(&args.out, ".rpmap");
-    file.write_file(&rpmap).map_err(failure)?;
-    Ok(Written {
-        pgm,
-        yaml,
-        png,
-        rpmap,
-    })
-}
-
-/// What `raypath map` prints.
-struct Report {
-    model: &'static str,
-    posterior: bool,
-    dims: usize,
-    grid_dims: Vec<usize>,
-    resolution: f64,
-    cells: usize,
-    observed_cells: usize,
-    summary: MappingSummary,
-    extent_min: Vec<f64>,
-    extent_max: Vec<f64>,
-    mapping_secs: f64,
-    total_secs: f64,
-    written: Written,
-}
-
-impl Report {
-    fn of(
-        args: &Args,
-        file: &MapFile,
-        dims: usize,
-        mapping_secs: f64,
-        started: Instant,
-        written: Written,
-    ) -> Self {
-        let (grid_dims, cells, observed, summary, min, max) = match &file.stats {
-            StoredStats::Planar(s) => {
-                let b = s.grid().bounds();
-                (
-                    s.grid().dims().to_vec(),
-                    s.cells().len(),
-                    s.cells().iter().filter(|c| !c.is_empty()).count(),
-                    *s.summary(),
-                    vec![b.min.x, b.min.y],
-                    vec![b.max.x, b.max.y],
-                )
-            }
-            StoredStats::Spatial(s) => {
-                let b = s.grid().bounds();
-                (
-                    s.grid().dims().to_vec(),
-                    s.cells().len(),
-                    s.cells().iter().filter(|c| !c.is_empty()).count(),
-                    *s.summary(),
-                    vec![b.min.x, b.min.y, b.min.z],
-                    vec![b.max.x, b.max.y, b.max.z],
-                )
-            }
-        };
-        Self {
-            model: args.model.name(),
-            posterior: args.posterior,
-            dims,
-            grid_dims,
-            resolution: args.resolution,
-            cells,
-            observed_cells: observed,
-            summary,
-            extent_min: min,
-            extent_max: max,
-            mapping_secs,
-            total_secs: started.elapsed().as_secs_f64(),
-            written,
-        }
-    }
-
-    fn rays_per_second(&self) -> f64 {
-        if self.mapping_secs > 0.0 {
-            self.summary.rays as f64 / self.mapping_secs
+    println!(
+        "{} map{} ({}-D), {} m cells: {} = {} cells, {} observed",
+        report.model,
+        if report.posterior {
+            " (full posterior)"
         } else {
-            0.0
-        }
-    }
-
-    fn json(&self) -> serde_json::Value {
-        let path = |p: &Path| p.display().to_string();
-        serde_json::json!({
-            "model": self.model,
-            "posterior": self.posterior,
-            "dimensions": self.dims,
-            "resolution": self.resolution,
-            "grid": self.grid_dims,
-            "cells": self.cells,
-            "observed_cells": self.observed_cells,
-            "rays": self.summary.rays,
-            "hits": self.summary.hits,
-            "no_returns_traced": self.summary.no_returns_traced,
-            "no_returns_skipped": self.summary.no_returns_skipped,
-            "endpoints_outside": self.summary.endpoints_outside,
-            "sub_ignored": self.summary.sub_ignored,
-            "crossings": self.summary.crossings,
-            "extent": { "min": self.extent_min, "max": self.extent_max },
-            "mapping_seconds": self.mapping_secs,
-            "seconds": self.total_secs,
-            "rays_per_second": self.rays_per_second(),
-            "files": {
-                "pgm": path(&self.written.pgm),
-                "yaml": path(&self.written.yaml),
-                "png": path(&self.written.png),
-                "rpmap": path(&self.written.rpmap),
-            },
-        })
-    }
-
-    fn print(&self) {
-        let grid: Vec<String> = self.grid_dims.iter().map(usize::to_string).collect();
-        let coords = |v: &[f64]| {
-            v.iter()
-                .map(|x| format!("{x:.2}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        println!(
-            "{} map{} ({}-D), {} m cells: {} = {} cells, {} observed",
-            self.model,
-            if self.posterior {
-                " (full posterior)"
-            } else {
-                ""
-            },
-            self.dims,
-            self.resolution,
-            grid.join(" × "),
-            self.cells,
-            self.observed_cells
-        );
-        println!(
-            "extent: [{}] to [{}] m",
-            coords(&self.extent_min),
-            coords(&self.extent_max)
-        );
-        println!(
-            "rays: {} ({} hits, {} no-returns traced, {} returns ending outside the grid, {} below r_min)",
-            self.summary.rays,
-            self.summary.hits,
-            self.summary.no_returns_traced,
-            self.summary.endpoints_outside,
-            self.summary.sub_ignored
-        );
-        println!(
-            "time: {:.2} s mapping ({:.0} rays/s), {:.2} s in all",
-            self.mapping_secs,
-            self.rays_per_second(),
-            self.total_secs
-        );
-        for p in [
-            &self.written.pgm,
-            &self.written.yaml,
-            &self.written.png,
-            &self.written.rpmap,
-        ] {
-            println!("wrote {}", p.display());
-        }
+            ""
+        },
+        report.dimensions,
+        report.resolution,
+        grid.join(" × "),
+        report.cells,
+        report.observed_cells
+    );
+    println!(
+        "extent: [{}] to [{}] m",
+        coords(&report.extent.min),
+        coords(&report.extent.max)
+    );
+    println!(
+        "rays: {} ({} hits, {} no-returns traced, {} returns ending outside the grid, {} below r_min)",
+        report.rays,
+        report.hits,
+        report.no_returns_traced,
+        report.endpoints_outside,
+        report.sub_ignored
+    );
+    println!(
+        "time: {:.2} s mapping ({:.0} rays/s), {:.2} s in all",
+        report.mapping_seconds, report.rays_per_second, report.seconds
+    );
+    let f = &report.files;
+    for p in [&f.pgm, &f.yaml, &f.png, &f.rpmap] {
+        println!("wrote {}", p.display());
     }
 }

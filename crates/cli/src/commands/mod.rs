@@ -33,6 +33,31 @@ pub fn choice_name<T: clap::ValueEnum>(value: &T) -> String {
         .unwrap_or_default()
 }
 
+/// Prints a command's typed report as one line of JSON (`--json`), its keys sorted (as the
+/// JSON of every command is).
+pub fn print_json(report: &impl serde::Serialize) -> Result<(), Failure> {
+    println!("{}", to_json(report)?);
+    Ok(())
+}
+
+/// A command's typed report as a JSON value (keys sorted), for commands that add to it
+/// (`--record`).
+pub fn to_json(report: &impl serde::Serialize) -> Result<serde_json::Value, Failure> {
+    serde_json::to_value(report).map_err(Failure::internal)
+}
+
+/// The JSON of a failure.
+#[derive(serde::Serialize)]
+struct ErrorReport<'a> {
+    error: &'a str,
+}
+
+/// Prints `{"error": message}` (the `--json` answer of a failure).
+pub fn print_error_json(message: &str) {
+    let doc = ErrorReport { error: message };
+    println!("{}", serde_json::to_value(&doc).unwrap_or_default());
+}
+
 /// Why a subcommand failed, and how to report it.
 pub struct Failure {
     /// The message (for input errors: `file:place: reason`).
@@ -63,7 +88,7 @@ impl Failure {
     pub fn report(&self) -> ExitCode {
         eprintln!("error: {}", self.message);
         if console::json() {
-            println!("{}", serde_json::json!({ "error": self.message }));
+            print_error_json(&self.message);
         }
         ExitCode::from(if self.bad_input { 2 } else { 1 })
     }

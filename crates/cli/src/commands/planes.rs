@@ -33,8 +33,8 @@ use std::time::Instant;
 use raypath_geometry::{PointCloud, Pose3};
 use raypath_io::foxglove::{Rgba, frame, topic};
 use raypath_io::pcd::{ReadOptions, read_pcd};
+use raypath_planes::report::{PlaneReport, PlanesReport};
 use raypath_planes::{MsacParams, PeacParams, PpeParams, Segmentation, extract, msac, peac};
-use serde_json::json;
 
 use super::Failure;
 use super::record::{RecordArgs, Recording, label_color, plane_entity};
@@ -258,23 +258,16 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         record(recording, stamp, &cloud, &seg)?;
     }
     if super::console::json() {
-        let planes: Vec<_> = seg
-            .planes
-            .iter()
-            .enumerate()
-            .map(|(i, p)| {
-                let n = p.fit.normal();
-                json!({"label": i + 1, "normal": [n.x, n.y, n.z], "distance": p.fit.distance_m(),
-                       "points": p.index.len(), "rmse": p.fit.rmse_m()})
-            })
-            .collect();
-        let (method, preset) = (
-            super::choice_name(&args.method),
-            super::choice_name(&args.preset),
-        );
-        let mut doc = json!({"scan": args.scan.display().to_string(), "width": cloud.width,
-            "height": cloud.height, "method": method, "preset": preset, "planes": planes,
-            "rmse": seg.rmse_m(), "seconds": seconds});
+        let mut doc = super::to_json(&PlanesReport {
+            scan: args.scan.display().to_string(),
+            width: cloud.width,
+            height: cloud.height,
+            method: super::choice_name(&args.method),
+            preset: super::choice_name(&args.preset),
+            planes: PlaneReport::all(&seg),
+            rmse: seg.rmse_m(),
+            seconds,
+        })?;
         super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
     } else {

@@ -41,11 +41,13 @@ use raypath_geometry::{Pose2, Pose3};
 use raypath_io::poles_csv::{PoleRecord, read_pole_csv, write_pole_csv};
 use raypath_localizer::PoseTrack;
 use raypath_localizer::eval::{EvaluationConfig, evaluate_trajectory};
+use raypath_poles::report::{
+    FinalPose, LocalizationSummary, PoleLocalizeReport, PoleMapReport, PoleReport, RunReport,
+};
 use raypath_poles::{
     Drive, DriveFormat, OdometryNoise, Pole, Preset, RunResult, filter_run, local_maps,
     online_poles, reference_map,
 };
-use serde_json::json;
 
 use super::Failure;
 use super::record::{RecordArgs, Recording};
@@ -121,16 +123,6 @@ pub enum PresetArg {
     Kitti,
 }
 
-/// Whether `sequence` (a KITTI sequence directory) belongs to a set written by
-/// `raypath simulate`: `<set>/sequences/NN` with `<set>/set.json`.
-fn simulated_set(sequence: &std::path::Path) -> bool {
-    sequence
-        .ancestors()
-        .skip(1)
-        .take(2)
-        .any(|dir| dir.join("set.json").is_file())
-}
-
 /// Arguments of `raypath poles extract`.
 #[derive(clap::Args)]
 pub struct ExtractArgs {
@@ -202,7 +194,7 @@ fn open(common: &Common) -> Result<(Drive, Preset, std::ops::Range<usize>), Fail
         SweepTimingArg::Kitti => true,
         SweepTimingArg::Origin => false,
         SweepTimingArg::Auto => {
-            drive.format() == DriveFormat::Kitti && !simulated_set(&common.sequence)
+            drive.format() == DriveFormat::Kitti && !raypath_sim::in_generated_set(&common.sequence)
         }
     };
     drive.sweep_timing = kitti_timing.then(raypath_poles::SweepTiming::kitti);
@@ -243,13 +235,8 @@ fn timing_name(drive: &Drive) -> &'static str {
     }
 }
 
-fn poles_json(poles: &[Pole]) -> serde_json::Value {
-    poles
-        .iter()
-        .map(|p| {
-            json!({"x": p.x, "y": p.y, "width": p.width, "height": p.height(), "score": p.score})
-        })
-        .collect()
+fn pole_reports(poles: &[Pole]) -> Vec<PoleReport> {
+    poles.iter().map(PoleReport::from).collect()
 }
 
 /// The rows of a pole-map CSV.
@@ -299,15 +286,16 @@ fn extract(args: &ExtractArgs) -> Result<(), Failure> {
         record::mapping(recording, &drive, &track, &used, &poles)?;
     }
     if super::console::json() {
-        let mut doc = json!({
-            "sequence": c.sequence.display().to_string(),
-            "preset": preset_name(c, &drive),
-            "sweep_timing": timing_name(&drive),
-            "scans": scans,
-            "local_maps": maps.len().min(1),
-            "poles": poles_json(&poles),
-            "points_per_sec": totals.points_per_sec(),
-        });
+        let mut doc = super::to_json(&PoleMapReport {
+            sequence: c.sequence.display().to_string(),
+            preset: preset_name(c, &drive),
+            sweep_timing: timing_name(&drive),
+            scans,
+            local_maps: maps.len().min(1),
+            poles: pole_reports(&poles),
+            points_per_sec: totals.points_per_sec(),
+            out: None,
+        })?;
         super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
     } else {
@@ -338,16 +326,16 @@ fn map(args: &MapArgs) -> Result<(), Failure> {
         record::mapping(recording, &drive, &track, &used, &poles)?;
     }
     if super::console::json() {
-        let mut doc = json!({
-            "sequence": c.sequence.display().to_string(),
-            "preset": preset_name(c, &drive),
-            "sweep_timing": timing_name(&drive),
-            "scans": scans,
-            "local_maps": maps.len(),
-            "poles": poles_json(&poles),
-            "points_per_sec": totals.points_per_sec(),
-            "out": args.out.display().to_string(),
-        });
+        let mut doc = super::to_json(&PoleMapReport {
+            sequence: c.sequence.display().to_string(),
+            preset: preset_name(c, &drive),
+            sweep_timing: timing_name(&drive),
+            scans,
+            local_maps: maps.len(),
+            poles: pole_reports(&poles),
+            points_per_sec: totals.points_per_sec(),
+            out: Some(args.out.display().to_string()),
+        })?;
         super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
     } else {
@@ -444,7 +432,11 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
             record::localization(recording, &drive, range.clone(), &map, &track)?;
         }
         if let Some(last) = track.poses().last() {
-            finals.push(json!({"x": last.x(), "y": last.y(), "theta": last.theta()}));
+            finals.push(FinalPose {
+                x: last.x(),
+                y: last.y(),
+                theta: last.theta(),
+            });
         }
         if let Some(gt) = &drive.sweeps.reference {
             let end = range.end.min(gt.len());
@@ -463,48 +455,41 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
         }
     }
     // The keys every answer carries; `summary` is null without ground truth.
-    let mut answer = json!({
-        "sequence": c.sequence.display().to_string(),
-        "map": args.map.display().to_string(),
-        "preset": preset_name(c, &drive),
-            "sweep_timing": timing_name(&drive),
-        "runs": args.runs,
-        "summary": null,
-    });
+    let mut answer = PoleLocalizeReport {
+        sequence: c.sequence.display().to_string(),
+        map: args.map.display().to_string(),
+        preset: preset_name(c, &drive),
+        sweep_timing: timing_name(&drive),
+        runs: args.runs,
+        summary: None,
+        per_run: None,
+        final_poses: None,
+    };
     if runs.is_empty() {
         // No ground truth: report the final estimates only.
         if json {
-            answer["final_poses"] = finals.into();
-            super::record::finish(recording, Some(&mut answer))?;
-            println!("{answer}");
+            answer.final_poses = Some(finals);
+            let mut doc = super::to_json(&answer)?;
+            super::record::finish(recording, Some(&mut doc))?;
+            println!("{doc}");
         } else {
             println!(
                 "{}: {} run(s), no ground truth; final poses: {}",
                 c.sequence.display(),
                 args.runs,
-                serde_json::Value::from(finals)
+                super::to_json(&finals)?
             );
             super::record::finish(recording, None)?;
         }
         return Ok(());
     }
-    let summary = summary(&runs);
+    let summary = LocalizationSummary::of(&runs);
     if json {
-        let per_run: Vec<serde_json::Value> = runs
-            .iter()
-            .map(|r| {
-                json!({
-                    "mean_pos_m": r.evaluation.position_m.mean_abs,
-                    "rmse_pos_m": r.evaluation.position_m.rmse,
-                    "updates": r.updates,
-                    "diverged": r.evaluation.divergence.diverged(),
-                })
-            })
-            .collect();
-        answer["summary"] = summary;
-        answer["per_run"] = per_run.into();
-        super::record::finish(recording, Some(&mut answer))?;
-        println!("{answer}");
+        answer.summary = Some(summary);
+        answer.per_run = Some(runs.iter().map(RunReport::from).collect());
+        let mut doc = super::to_json(&answer)?;
+        super::record::finish(recording, Some(&mut doc))?;
+        println!("{doc}");
     } else {
         println!(
             "{}: {} run(s) on {} map poles",
@@ -514,25 +499,9 @@ fn localize(args: &LocalizeArgs) -> Result<(), Failure> {
         );
         println!(
             "{}",
-            serde_json::to_string_pretty(&summary).unwrap_or_default()
+            serde_json::to_string_pretty(&super::to_json(&summary)?).unwrap_or_default()
         );
         super::record::finish(recording, None)?;
     }
     Ok(())
-}
-
-/// The `summary` object: means over runs.
-fn summary(runs: &[RunResult]) -> serde_json::Value {
-    let n = runs.len().max(1) as f64;
-    let mean = |f: &dyn Fn(&RunResult) -> f64| runs.iter().map(f).sum::<f64>() / n;
-    let deg = 180.0 / std::f64::consts::PI;
-    json!({
-        "mean_pos_m": mean(&|r| r.evaluation.position_m.mean_abs),
-        "rmse_pos_m": mean(&|r| r.evaluation.position_m.rmse),
-        "mean_lat_m": mean(&|r| r.evaluation.lateral_m.mean_abs),
-        "mean_lon_m": mean(&|r| r.evaluation.longitudinal_m.mean_abs),
-        "mean_ang_deg": mean(&|r| r.evaluation.heading_rad.mean_abs * deg),
-        "rmse_ang_deg": mean(&|r| r.evaluation.heading_rad.rmse * deg),
-        "diverged_runs": runs.iter().filter(|r| r.evaluation.divergence.diverged()).count(),
-    })
 }

@@ -25,9 +25,9 @@ use std::path::{Path, PathBuf};
 use raypath_io::foxglove::{frame, topic};
 use raypath_io::sequence::PlanarFrame;
 use raypath_polylines::metrics::ray_metrics;
+use raypath_polylines::report::PolylinesReport;
 use raypath_polylines::svg::scan_svg;
 use raypath_polylines::{Method, Optimizer, PolylineConfig, Polylines, extract};
-use serde_json::json;
 
 use super::Failure;
 use super::record::{RecordArgs, Recording, polyline_entities};
@@ -213,7 +213,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         });
     }
     if super::console::json() {
-        let mut doc = to_json(args, &config, &results);
+        let mut doc = super::to_json(&report(args, &config, &results))?;
         super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
     } else {
@@ -241,38 +241,12 @@ fn record(recording: &mut Recording, frame: &PlanarFrame, map: &Polylines) -> Re
     )
 }
 
-fn to_json(args: &Args, config: &PolylineConfig, results: &[Extracted]) -> serde_json::Value {
-    let scans: Vec<_> = results
+fn report(args: &Args, config: &PolylineConfig, results: &[Extracted]) -> PolylinesReport {
+    let extracted: Vec<_> = results
         .iter()
-        .map(|r| {
-            let polylines: Vec<Vec<[f64; 2]>> = r
-                .map
-                .lines
-                .iter()
-                .map(|l| l.vertices.iter().map(|v| [v.x, v.y]).collect())
-                .collect();
-            json!({
-                "index": r.index,
-                "polylines": polylines,
-                "rmse": r.rmse_m,
-                "f": r.f,
-            })
-        })
+        .map(|r| (r.index, &r.map, r.rmse_m, r.f))
         .collect();
-    let closed: Vec<Vec<bool>> = results
-        .iter()
-        .map(|r| r.map.lines.iter().map(|l| l.closed).collect())
-        .collect();
-    json!({
-        "scans": scans,
-        "log": args.log.display().to_string(),
-        "method": config.method.name(),
-        "optimizer": (config.method == Method::PlePlus).then(|| config.optimizer.name()),
-        "max_vertices": config.max_vertices,
-        "max_edge_m": config.max_edge_m,
-        "removed_residual_m": config.removed_residual_m,
-        "closed": closed,
-    })
+    PolylinesReport::new(args.log.display().to_string(), config, &extracted)
 }
 
 fn print_text(args: &Args, config: &PolylineConfig, results: &[Extracted]) {

@@ -26,7 +26,7 @@ use std::path::PathBuf;
 
 use raypath_geometry::{Grid2, PointCloud, Pose2, Pose3, Scan2};
 use raypath_io::foxglove::{Entity, GridLayer, GridValues, Recorder, Rgba, frame, topic};
-use serde_json::{Value, json};
+use serde_json::Value;
 
 use super::Failure;
 
@@ -250,6 +250,13 @@ impl Recording {
     }
 }
 
+/// The `"record"` object a command's `--json` document gets.
+#[derive(serde::Serialize)]
+struct RecordSummary {
+    path: String,
+    messages: BTreeMap<String, u64>,
+}
+
 /// Finishes the recording, if there is one. With `doc` (the command's `--json` document, an
 /// object) adds `"record": {"path", "messages": {topic: count}}` and prints nothing; without,
 /// prints `recorded PATH: N messages (topic n, …)`.
@@ -261,10 +268,11 @@ pub fn finish(recording: Option<Recording>, doc: Option<&mut Value>) -> Result<(
     let counts: BTreeMap<String, u64> = recording.recorder.finish().map_err(Failure::internal)?;
     match doc.and_then(Value::as_object_mut) {
         Some(object) => {
-            object.insert(
-                "record".into(),
-                json!({ "path": path.display().to_string(), "messages": counts }),
-            );
+            let summary = RecordSummary {
+                path: path.display().to_string(),
+                messages: counts,
+            };
+            object.insert("record".into(), super::to_json(&summary)?);
         }
         None => {
             let total: u64 = counts.values().sum();

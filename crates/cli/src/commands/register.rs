@@ -35,10 +35,10 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use raypath_geometry::{PointCloud, Pose3};
-use raypath_registration::{
-    Kernel, Odometry, OdometryConfig, Registration, RegistrationConfig, register,
+use raypath_registration::report::{
+    PairReport, SequenceReport, SequenceSummary, StepError, StepReport,
 };
-use serde_json::{Value, json};
+use raypath_registration::{Kernel, Odometry, OdometryConfig, RegistrationConfig, register};
 
 use super::Failure;
 use super::source_args::{SourceArgs, is_bag};
@@ -113,27 +113,6 @@ fn read_scan(path: &Path) -> Result<PointCloud, Failure> {
     })
 }
 
-fn pose_json(pose: &Pose3) -> Value {
-    let q = pose.rotation();
-    let (roll, pitch, yaw) = pose.rpy();
-    json!({
-        "translation_m": pose.translation().as_slice(),
-        "rotation_xyzw": [q.i, q.j, q.k, q.w],
-        "rpy_deg": [roll.to_degrees(), pitch.to_degrees(), yaw.to_degrees()],
-    })
-}
-
-fn registration_json(r: &Registration) -> Value {
-    json!({
-        "iterations": r.iterations,
-        "converged": r.converged,
-        "fitness": r.fitness,
-        "rmse_m": r.rmse_m,
-        "correspondences": r.correspondences,
-        "source_points": r.source_points,
-    })
-}
-
 fn pair(args: &Args, target_path: &Path, config: &RegistrationConfig) -> Result<(), Failure> {
     let source = read_scan(&args.input)?;
     let target = read_scan(target_path)?;
@@ -142,15 +121,13 @@ fn pair(args: &Args, target_path: &Path, config: &RegistrationConfig) -> Result<
     let seconds = started.elapsed().as_secs_f64();
     let pose = found.target_from_source;
     if super::console::json() {
-        let mut out = json!({
-            "mode": "pair",
-            "source": args.input.display().to_string(),
-            "target": target_path.display().to_string(),
-            "target_from_source": pose_json(&pose),
-            "seconds": seconds,
-        });
-        merge(&mut out, registration_json(&found));
-        println!("{out}");
+        let report = PairReport::new(
+            args.input.display().to_string(),
+            target_path.display().to_string(),
+            &found,
+            seconds,
+        );
+        super::print_json(&report)?;
         return Ok(());
     }
     let t = pose.translation();
@@ -186,57 +163,6 @@ fn pair(args: &Args, target_path: &Path, config: &RegistrationConfig) -> Result<
     Ok(())
 }
 
-fn merge(into: &mut Value, from: Value) {
-    if let (Some(into), Value::Object(from)) = (into.as_object_mut(), from) {
-        into.extend(from);
-    }
-}
-
-/// Error of an estimated relative pose against the reference's.
-fn step_error(truth: &Pose3, estimate: &Pose3) -> Value {
-    let d = truth.inverse() * *estimate;
-    json!({
-        "rotation_deg": d.rotation().angle().to_degrees(),
-        "translation_m": d.translation().norm(),
-        "distance_m": truth.translation().norm(),
-    })
-}
-
-fn summary(steps: &[Value]) -> Option<Value> {
-    let errors: Vec<&Value> = steps
-        .iter()
-        .filter_map(|s| s.get("error"))
-        .filter(|e| !e.is_null())
-        .collect();
-    if errors.is_empty() {
-        return None;
-    }
-    let field =
-        |name: &str| -> Vec<f64> { errors.iter().filter_map(|e| e[name].as_f64()).collect() };
-    let (rot, trans, dist) = (
-        field("rotation_deg"),
-        field("translation_m"),
-        field("distance_m"),
-    );
-    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
-    let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
-    let mut seconds: Vec<f64> = steps
-        .iter()
-        .filter(|s| !s["iterations"].is_null())
-        .filter_map(|s| s["seconds"].as_f64())
-        .collect();
-    seconds.sort_by(f64::total_cmp);
-    Some(json!({
-        "pairs": errors.len(),
-        "rotation_error_deg_mean": mean(&rot),
-        "rotation_error_deg_max": max(&rot),
-        "translation_error_m_mean": mean(&trans),
-        "translation_error_m_max": max(&trans),
-        "translation_error_percent": 100.0 * trans.iter().sum::<f64>() / dist.iter().sum::<f64>(),
-        "seconds_median": seconds.get(seconds.len() / 2),
-    }))
-}
-
 fn sequence(args: &Args, config: RegistrationConfig) -> Result<(), Failure> {
     let bad = |e: raypath_io::Error| Failure::input(e);
     let sweeps = args.source.open_sweeps(&args.input).map_err(bad)?;
@@ -259,24 +185,13 @@ fn sequence(args: &Args, config: RegistrationConfig) -> Result<(), Failure> {
         let seconds = started.elapsed().as_secs_f64();
         let poses = odometry.poses();
         let error = match (k, reference) {
-            (1.., Some(truth)) => step_error(
+            (1.., Some(truth)) => Some(StepError::new(
                 &(truth[k - 1].inverse() * truth[k]),
                 &(poses[k - 1].inverse() * poses[k]),
-            ),
-            _ => Value::Null,
+            )),
+            _ => None,
         };
-        let mut entry = json!({
-            "frame": k,
-            "sigma_m": step.sigma_m,
-            "map_points": step.map_points,
-            "seconds": seconds,
-            "error": error,
-        });
-        merge(&mut entry, pose_json(&step.world_from_sensor));
-        match &step.registration {
-            Some(r) => merge(&mut entry, registration_json(r)),
-            None => merge(&mut entry, json!({"iterations": null})),
-        }
+        let entry = StepReport::new(k, &step, seconds, error);
         if !super::console::json() {
             print_step(&entry);
         }
@@ -285,29 +200,26 @@ fn sequence(args: &Args, config: RegistrationConfig) -> Result<(), Failure> {
     if let Some(out) = &args.out {
         raypath_io::kitti::write_poses(out, odometry.poses()).map_err(bad)?;
     }
-    let summary = summary(&steps);
+    let summary = SequenceSummary::of(&steps);
     if super::console::json() {
-        println!(
-            "{}",
-            json!({
-                "mode": "sequence",
-                "input": args.input.display().to_string(),
-                "frames": n,
-                "steps": steps,
-                "summary": summary,
-                "out": args.out.as_ref().map(|p| p.display().to_string()),
-            })
-        );
+        super::print_json(&SequenceReport {
+            mode: "sequence",
+            input: args.input.display().to_string(),
+            frames: n,
+            steps,
+            summary,
+            out: args.out.as_ref().map(|p| p.display().to_string()),
+        })?;
     } else if let Some(s) = summary {
         println!(
             "{} pairs against the reference: rotation error mean {:.3}° (max {:.3}°), \
              translation error mean {:.3} m (max {:.3} m), {:.2} % of the distance",
-            s["pairs"],
-            s["rotation_error_deg_mean"].as_f64().unwrap_or(f64::NAN),
-            s["rotation_error_deg_max"].as_f64().unwrap_or(f64::NAN),
-            s["translation_error_m_mean"].as_f64().unwrap_or(f64::NAN),
-            s["translation_error_m_max"].as_f64().unwrap_or(f64::NAN),
-            s["translation_error_percent"].as_f64().unwrap_or(f64::NAN),
+            s.pairs,
+            s.rotation_error_deg_mean,
+            s.rotation_error_deg_max,
+            s.translation_error_m_mean,
+            s.translation_error_m_max,
+            s.translation_error_percent,
         );
     } else {
         println!("{n} sweeps registered (no reference poses to compare with)");
@@ -315,31 +227,27 @@ fn sequence(args: &Args, config: RegistrationConfig) -> Result<(), Failure> {
     Ok(())
 }
 
-fn print_step(entry: &Value) {
-    let t: Vec<f64> = entry["translation_m"]
-        .as_array()
-        .map(|a| a.iter().filter_map(Value::as_f64).collect())
-        .unwrap_or_default();
-    let yaw = entry["rpy_deg"][2].as_f64().unwrap_or(f64::NAN);
+/// The human line of one step (a non-finite figure prints as NaN, as it shows as null in
+/// the JSON).
+fn print_step(entry: &StepReport) {
+    let finite = |v: f64| if v.is_finite() { v } else { f64::NAN };
+    let t = entry.pose.translation_m;
     let mut line = format!(
-        "frame {:>4}: ({:.3}, {:.3}, {:.3}) m, yaw {:.3}°",
-        entry["frame"],
-        t.first().copied().unwrap_or(f64::NAN),
-        t.get(1).copied().unwrap_or(f64::NAN),
-        t.get(2).copied().unwrap_or(f64::NAN),
-        yaw
+        "frame {}: ({:.3}, {:.3}, {:.3}) m, yaw {:.3}°",
+        entry.frame,
+        finite(t[0]),
+        finite(t[1]),
+        finite(t[2]),
+        finite(entry.pose.rpy_deg[2])
     );
-    if let Some(it) = entry["iterations"].as_u64() {
-        line += &format!(
-            ", {it} iterations, {:.0} ms",
-            entry["seconds"].as_f64().unwrap_or(f64::NAN) * 1e3
-        );
+    if let Some(it) = entry.iterations {
+        line += &format!(", {it} iterations, {:.0} ms", finite(entry.seconds) * 1e3);
     }
-    if let Some(e) = entry["error"].as_object() {
+    if let Some(e) = &entry.error {
         line += &format!(
             ", error {:.3}° {:.3} m",
-            e["rotation_deg"].as_f64().unwrap_or(f64::NAN),
-            e["translation_m"].as_f64().unwrap_or(f64::NAN)
+            finite(e.rotation_deg),
+            finite(e.translation_m)
         );
     }
     println!("{line}");

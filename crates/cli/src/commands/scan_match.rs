@@ -33,7 +33,7 @@ use raypath_io::sequence::{Origin, PlanarFrame, pair_by_ranges};
 use raypath_reflectivity::benchmark::{
     aligned_errors, consecutive_relations, relative_errors, run_matcher,
 };
-use raypath_reflectivity::export::{tum_lines, write_occupancy_map, write_reflectivity_png};
+use raypath_reflectivity::export::{write_occupancy_map, write_reflectivity_png};
 use raypath_reflectivity::{
     IntensityCorrection, MapConfig, MatcherConfig, PointFilter, ResidualMode,
 };
@@ -301,9 +301,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let poses: Vec<Pose2> = results.iter().map(|r| r.world_from_sensor).collect();
     if let Some(out) = &args.out {
         let stamps = ipc_stamps(args, &scans)?;
-        let text = tum_lines(stamps.into_iter().zip(poses.iter().copied()));
-        std::fs::write(out, text)
-            .map_err(|e| Failure::internal(format!("{}: {e}", out.display())))?;
+        raypath_io::tum::write_planar_tum(out, None, stamps.into_iter().zip(poses.iter().copied()))
+            .map_err(Failure::internal)?;
     }
     if let Some(path) = &args.corrected_log {
         write_corrected_log(args, path, &scans, &poses)?;

@@ -12,8 +12,8 @@ use std::io::BufRead;
 use std::path::PathBuf;
 
 use raypath_io::pcd::{LabelSource, ReadOptions, read_pcd, read_pcd_header};
+use raypath_planes::report::HooverReport;
 use raypath_planes::{HooverParams, compare};
-use serde_json::json;
 
 use super::Failure;
 
@@ -91,10 +91,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     };
     let r = compare(&gt, &ms, &params).map_err(Failure::input)?;
     if super::console::json() {
-        let doc = json!({"f": r.fraction_correct(), "k": r.k_value(), "n_o": r.over, "n_u": r.under,
-            "n_m": r.missed, "n_s": r.noise, "correct": r.correct.len(), "gt_planes": r.gt_regions,
-            "segments": r.ms_regions, "tolerance": args.tolerance});
-        println!("{doc}");
+        super::print_json(&HooverReport::new(&r, args.tolerance))?;
     } else {
         println!(
             "GT planes {}, segments {}: correct {} (f = {:.1} %, k = {:.1} %), over {}, under {}, missed {}, noise {}",

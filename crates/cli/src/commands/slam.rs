@@ -51,13 +51,11 @@ use raypath_io::foxglove::{frame, topic};
 use raypath_io::relations::read_relations;
 use raypath_io::sequence::{PlanarFrame, pair_reference};
 use raypath_reflectivity::ResidualMode;
-use raypath_sensor_models::export::{MapFile, StoredStats};
+use raypath_sensor_models::export::{MapFile, MapReport, StoredStats, write_map_files};
 use raypath_slam::benchmark::{
-    LoopPairing, RefineConfig, check_loops, consecutive_relations, explicit_relation_errors,
-    file_relation_errors, match_relation_file, random_relations, refine_relations, relation_errors,
+    ErrorSummary, ReferenceScore, RelationFileScore, match_relation_file, score_reference,
 };
-use raypath_slam::{Slam, SlamConfig, SlamOutput};
-use serde_json::{Value, json};
+use raypath_slam::{MapSettings, Slam, SlamConfig, SlamOutput, SlamReport};
 
 use super::Failure;
 use super::map::Model;
@@ -134,10 +132,6 @@ impl ModeArg {
     }
 }
 
-/// Loop closures between scans without a reference are checked against the nearest referenced
-/// scan at most this many scans away, moved by the front-end's relative motion.
-const NEIGHBOUR_GAP: usize = 50;
-
 fn config(args: &Args) -> Result<SlamConfig, Failure> {
     let mut config = SlamConfig::default();
     config.matcher.map.finest_resolution_m = args.resolution;
@@ -183,98 +177,60 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let output = slam.finish().map_err(Failure::internal)?;
     super::console::stage("slam", started);
     let seconds = started.elapsed().as_secs_f64();
-    let outputs = write_outputs(args, &frames, &output)?;
-    let map = rebuild_map(args, &outputs.corrected)?;
-    let evaluation = match &args.ground_truth {
-        Some(path) => Some(evaluate(args, path, &mut frames, &output)?),
-        None => None,
-    };
-    let relation_file = match &args.relations {
-        Some(path) => Some(score_relation_file(args, path, &frames, &output)?),
-        None => None,
-    };
-    if let Some(recording) = &mut recording {
-        record(recording, &frames, &output, &outputs.map_prefix, args.model)?;
+    let files = output
+        .write_files(&args.out, &frames)
+        .map_err(Failure::internal)?;
+    let (map, map_file) = rebuild_map(args, &frames, &output)?;
+    let mut report = SlamReport::new(&output, seconds, files, map);
+    if let Some(path) = &args.ground_truth {
+        report.reference = Some(evaluate(args, path, &mut frames, &output)?);
     }
-    let mut doc = report(&output, seconds, &outputs, map, evaluation);
-    if let (Some(r), Some(obj)) = (relation_file, doc.as_object_mut()) {
-        obj.insert("relations_file".into(), r);
+    if let Some(path) = &args.relations {
+        report.relations_file = Some(score_relation_file(args, path, &frames, &output)?);
+    }
+    if let Some(recording) = &mut recording {
+        record(recording, &frames, &output, &map_file, args.model)?;
     }
     if super::console::json() {
+        let mut doc = super::to_json(&report)?;
         super::record::finish(recording, Some(&mut doc))?;
         println!("{doc}");
     } else {
-        print(&doc);
+        print(&report);
         super::record::finish(recording, None)?;
     }
     Ok(())
 }
 
-struct Outputs {
-    trajectory: PathBuf,
-    corrected: PathBuf,
-    loops: PathBuf,
-    map_prefix: PathBuf,
-}
-
-fn write_outputs(
+/// The map of the scans at the optimised poses (`raypath_slam::rebuild_map`), written as
+/// `map.*` like `raypath map` writes a map.
+fn rebuild_map(
     args: &Args,
     frames: &[PlanarFrame],
-    out: &SlamOutput,
-) -> Result<Outputs, Failure> {
-    let trajectory = args.out.join("trajectory.txt");
-    out.write_tum(&trajectory).map_err(Failure::internal)?;
-    let corrected = args.out.join("corrected.log");
-    out.write_corrected_log(frames, &corrected)
-        .map_err(Failure::internal)?;
-    let loops = args.out.join("loop_closures.csv");
-    let mut text = String::from("scan,anchor_scan,node,submap,x,y,theta,score,source\n");
-    for c in &out.loop_closures {
-        let scan = out.node_scan.get(c.node).copied().unwrap_or(usize::MAX);
-        let anchor = out.node_scan.get(c.anchor).copied().unwrap_or(usize::MAX);
-        let p = c.submap_from_sensor;
-        let source = match c.source {
-            raypath_slam::LoopSource::Nearby => "nearby",
-            raypath_slam::LoopSource::PlaceRecognition => "place-recognition",
-            raypath_slam::LoopSource::Global => "global",
-        };
-        text.push_str(&format!(
-            "{scan},{anchor},{},{},{},{},{},{},{source}\n",
-            c.node,
-            c.submap,
-            p.x(),
-            p.y(),
-            p.theta(),
-            c.score
-        ));
-    }
-    std::fs::write(&loops, text)
-        .map_err(|e| Failure::internal(format!("{}: {e}", loops.display())))?;
-    Ok(Outputs {
-        trajectory,
-        corrected,
-        loops,
-        map_prefix: args.out.join("map"),
-    })
-}
-
-/// The map of `raypath map` over the corrected log (the optimised poses).
-fn rebuild_map(args: &Args, corrected: &Path) -> Result<Value, Failure> {
-    let map_args = super::map::Args {
-        input: corrected.to_path_buf(),
-        model: args.model,
-        posterior: false,
-        resolution: args.resolution,
-        out: args.out.join("map"),
-        max_range: args.max_range,
-        min_range: 0.0,
-        ray_step: 1,
-        skip_no_returns: true,
-        sparse: false,
-        source: SourceArgs::default(),
-        record: RecordArgs::default(),
+    output: &SlamOutput,
+) -> Result<(MapReport, MapFile), Failure> {
+    let started = Instant::now();
+    let settings = MapSettings {
+        kind: args.model.kind(),
+        resolution_m: args.resolution,
+        max_range_m: args.max_range,
     };
-    super::map::build_json(&map_args)
+    let spinner = super::console::spinner("mapping");
+    let file = raypath_slam::rebuild_map(frames, &output.world_from_sensor, &settings)
+        .map_err(Failure::input)?;
+    spinner.finish_and_clear();
+    super::console::stage("mapping", started);
+    let mapping_seconds = started.elapsed().as_secs_f64();
+    let files = write_map_files(&args.out.join("map"), &file, args.model.picture())
+        .map_err(Failure::internal)?;
+    let report = MapReport::new(
+        &file,
+        args.resolution,
+        mapping_seconds,
+        started.elapsed().as_secs_f64(),
+        files,
+    );
+    Ok((report, file))
 }
 
 /// Relation errors against the ground truth and the check of every loop closure.
@@ -283,7 +239,7 @@ fn evaluate(
     path: &Path,
     frames: &mut [PlanarFrame],
     out: &SlamOutput,
-) -> Result<Value, Failure> {
+) -> Result<ReferenceScore, Failure> {
     let reference = args.source.read_frames(path).map_err(Failure::input)?;
     let paired = pair_reference(frames, &reference);
     if paired < 2 {
@@ -293,46 +249,7 @@ fn evaluate(
             args.log.display()
         )));
     }
-    let truth: Vec<_> = frames.iter().map(|f| f.reference).collect();
-    let referenced: Vec<usize> = (0..frames.len()).filter(|&i| truth[i].is_some()).collect();
-    let summary = relation_errors(
-        &truth,
-        &out.world_from_sensor,
-        &consecutive_relations(&referenced),
-    );
-    let random = relation_errors(
-        &truth,
-        &out.world_from_sensor,
-        &random_relations(&referenced, 1000, 1),
-    );
-    let scans: Vec<_> = frames.iter().map(|f| &f.scan).collect();
-    let (checked, wrong, checks) =
-        check_loops(out, &scans, &truth, NEIGHBOUR_GAP, LoopPairing::Overlap);
-    let (_, wrong_nearest, _) =
-        check_loops(out, &scans, &truth, NEIGHBOUR_GAP, LoopPairing::Nearest);
-    let refined = refine_relations(
-        &scans,
-        &truth,
-        &consecutive_relations(&referenced),
-        &RefineConfig::default(),
-    )
-    .map_err(Failure::internal)?;
-    let (moved, _) = refined.correction_m();
-    let disputed = raypath_slam::benchmark::wrong_at_disputed_reference(&checks, &scans, &truth);
-    Ok(json!({
-        "paired_scans": paired,
-        "summary": summary,
-        "random_pairs": random,
-        "scan_refined": {
-            "summary": explicit_relation_errors(&out.world_from_sensor, &refined.relations),
-            "dropped": refined.dropped,
-            "reference_moved_m": moved,
-        },
-        "loop_closures_checked": checked,
-        "wrong_loop_closures": wrong,
-        "wrong_loop_closures_nearest_node": wrong_nearest,
-        "wrong_loop_closures_reference_disputed": disputed,
-    }))
+    score_reference(frames, paired, out).map_err(Failure::internal)
 }
 
 /// Relation errors over the benchmark's relation file `path`, its scans found by ipc time stamp.
@@ -341,7 +258,7 @@ fn score_relation_file(
     path: &Path,
     frames: &[PlanarFrame],
     out: &SlamOutput,
-) -> Result<Value, Failure> {
+) -> Result<RelationFileScore, Failure> {
     let relations = read_relations(path).map_err(Failure::input)?;
     let stamps: Vec<_> = frames.iter().map(|f| f.ipc_stamp_secs).collect();
     let matched = match_relation_file(&stamps, &relations);
@@ -354,66 +271,25 @@ fn score_relation_file(
             args.log.display()
         )));
     }
-    Ok(json!({
-        "path": path,
-        "summary": file_relation_errors(&out.world_from_sensor, &matched),
-        "unmatched": matched.unmatched,
-    }))
+    Ok(RelationFileScore::new(path.to_path_buf(), &matched, out))
 }
 
-fn report(
-    out: &SlamOutput,
-    seconds: f64,
-    outputs: &Outputs,
-    map: Value,
-    evaluation: Option<Value>,
-) -> Value {
-    let mut doc = json!({
-        "scans": out.scans.len(),
-        "nodes": out.nodes.len(),
-        "submaps": out.submaps.len(),
-        "loop_closures": out.loop_closures.len(),
-        "rejected_loop_closures": out.rejected_loop_closures.len(),
-        "seconds": seconds,
-        "scans_per_second": out.scans.len() as f64 / seconds.max(1e-9),
-        "timing": out.stats,
-        "outputs": {
-            "trajectory": outputs.trajectory,
-            "corrected_log": outputs.corrected,
-            "loop_closures": outputs.loops,
-        },
-        "map": map,
-    });
-    if let (Some(Value::Object(e)), Some(obj)) = (evaluation, doc.as_object_mut()) {
-        obj.extend(e);
-    }
-    doc
-}
-
-fn print(doc: &Value) {
+fn print(report: &SlamReport) {
     println!(
         "{} scans, {} nodes, {} submaps, {} loop closures ({} rejected): {:.2} s, {:.0} scans/s",
-        doc["scans"],
-        doc["nodes"],
-        doc["submaps"],
-        doc["loop_closures"],
-        doc["rejected_loop_closures"],
-        doc["seconds"].as_f64().unwrap_or(f64::NAN),
-        doc["scans_per_second"].as_f64().unwrap_or(f64::NAN),
+        report.scans,
+        report.nodes,
+        report.submaps,
+        report.loop_closures,
+        report.rejected_loop_closures,
+        report.seconds,
+        report.scans_per_second,
     );
-    println!(
-        "trajectory: {}",
-        doc["outputs"]["trajectory"].as_str().unwrap_or("?")
-    );
-    println!(
-        "corrected log: {}",
-        doc["outputs"]["corrected_log"].as_str().unwrap_or("?")
-    );
-    println!(
-        "map: {}",
-        doc["map"]["files"]["png"].as_str().unwrap_or("(see map.*)")
-    );
-    if let Ok(s) = serde_json::from_value::<SummaryView>(doc["summary"].clone()) {
+    println!("trajectory: {}", path(&report.outputs.trajectory));
+    println!("corrected log: {}", path(&report.outputs.corrected_log));
+    println!("map: {}", path(&report.map.files.png));
+    if let Some(r) = report.reference.as_ref().filter(|r| shown(&r.summary)) {
+        let s = &r.summary;
         println!(
             "relation error over {} consecutive reference pairs: {:.3} ± {:.3} m, {:.2} ± {:.2}°; \
              {} of {} checked loop closures wrong",
@@ -422,11 +298,16 @@ fn print(doc: &Value) {
             s.trans_error_std_m,
             s.rot_error_deg,
             s.rot_error_std_deg,
-            doc["wrong_loop_closures"],
-            doc["loop_closures_checked"],
+            r.wrong_loop_closures,
+            r.loop_closures_checked,
         );
     }
-    if let Ok(s) = serde_json::from_value::<SummaryView>(doc["scan_refined"]["summary"].clone()) {
+    if let Some(r) = report
+        .reference
+        .as_ref()
+        .filter(|r| shown(&r.scan_refined.summary))
+    {
+        let s = &r.scan_refined.summary;
         println!(
             "relation error over {} scan-refined consecutive pairs: {:.4} ± {:.4} m, {:.2} ± {:.2}° \
              (the refinement moved the reference by {:.4} m on average)",
@@ -435,33 +316,41 @@ fn print(doc: &Value) {
             s.trans_error_std_m,
             s.rot_error_deg,
             s.rot_error_std_deg,
-            doc["scan_refined"]["reference_moved_m"]
-                .as_f64()
-                .unwrap_or(f64::NAN),
+            r.scan_refined.reference_moved_m,
         );
     }
-    if let Ok(s) = serde_json::from_value::<SummaryView>(doc["relations_file"]["summary"].clone()) {
+    if let Some(f) = report.relations_file.as_ref().filter(|f| shown(&f.summary)) {
+        let s = &f.summary;
         println!(
             "relation error over {} relations of {}: {:.4} ± {:.4} m, {:.2} ± {:.2}° ({} not found in the log)",
             s.relations,
-            doc["relations_file"]["path"].as_str().unwrap_or("?"),
+            path(&f.path),
             s.trans_error_m,
             s.trans_error_std_m,
             s.rot_error_deg,
             s.rot_error_std_deg,
-            doc["relations_file"]["unmatched"],
+            f.unmatched,
         );
     }
 }
 
-/// The `summary` object read back for printing.
-#[derive(serde::Deserialize)]
-struct SummaryView {
-    trans_error_m: f64,
-    trans_error_std_m: f64,
-    rot_error_deg: f64,
-    rot_error_std_deg: f64,
-    relations: usize,
+/// Whether a summary line is printed: not when its figures are undefined (no relations; the
+/// JSON shows them as null).
+fn shown(s: &ErrorSummary) -> bool {
+    [
+        s.trans_error_m,
+        s.trans_error_std_m,
+        s.rot_error_deg,
+        s.rot_error_std_deg,
+    ]
+    .iter()
+    .all(|v| v.is_finite())
+}
+
+/// A path as the JSON report shows it (printed through the JSON value before: `?` when it is
+/// not valid UTF-8).
+fn path(p: &Path) -> &str {
+    p.to_str().unwrap_or("?")
 }
 
 /// Scans at the optimised poses, the trajectory, the rebuilt map and the loop closures.
@@ -469,14 +358,12 @@ fn record(
     recording: &mut Recording,
     frames: &[PlanarFrame],
     out: &SlamOutput,
-    map_prefix: &Path,
+    map: &MapFile,
     model: Model,
 ) -> Result<(), Failure> {
     recording.planar_track(frames, &out.world_from_sensor)?;
     let end = recording.end_stamp();
-    let rpmap = map_prefix.with_extension("rpmap");
-    let file = MapFile::read_file(&rpmap).map_err(Failure::internal)?;
-    if let StoredStats::Planar(stats) = &file.stats {
+    if let StoredStats::Planar(stats) = &map.stats {
         super::map::record::grid(recording, end, stats, model.picture())?;
     }
     let at = |node: usize| out.nodes.get(node).map(|p| Point3::new(p.x(), p.y(), 0.0));

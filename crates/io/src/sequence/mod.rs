@@ -20,6 +20,7 @@
 mod pairing;
 mod planar;
 mod sweeps;
+mod time_pairing;
 
 pub use pairing::{pair_by_ranges, pair_reference};
 pub use planar::{
@@ -28,6 +29,7 @@ pub use planar::{
 };
 pub(crate) use sweeps::interpolate;
 pub use sweeps::{SweepError, SweepFn, SweepFormat, SweepOptions, SweepSequence};
+pub use time_pairing::{MATCH_TOLERANCE_SECS, MAX_GAP_SECS, poses_at_times};
 
 /// Which topics and frames of a bag to read. Each `None` is chosen automatically when the bag
 /// leaves one choice (one topic of the type), and is an error naming the candidates otherwise.

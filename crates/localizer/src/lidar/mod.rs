@@ -85,11 +85,13 @@ mod build;
 mod config;
 mod mixture;
 mod planar;
+mod report;
 mod run;
 mod spatial;
 
 pub use build::{BoxedPlanarModel, ModelKind, ModelSpec};
 pub use config::{DEFAULT_RANDOM_WEIGHT, LidarConfig};
 pub use planar::{PlanarScan, Scan2Measurement};
+pub use report::{LocalizeReport, TrajectoryErrorReport};
 pub use run::{PlanarStep, PlanarTrack, TrackConfig, track_planar};
 pub use spatial::{Scan3Measurement, SpatialScan};

@@ -30,6 +30,7 @@ use serde::{Deserialize, Serialize};
 mod loop_check;
 mod refine;
 mod relation_file;
+mod report;
 
 pub use loop_check::{
     DISPUTE_GAP, LoopCheck, LoopPairing, REFUTE_SPAN, WRONG_LOOP_DEG, WRONG_LOOP_M, check_loops,
@@ -40,6 +41,7 @@ pub use relation_file::{
     MatchedRelations, STAMP_TOLERANCE_SECS, explicit_relation_errors, file_relation_errors,
     match_relation_file, relations_from_reference,
 };
+pub use report::{NEIGHBOUR_GAP, ReferenceScore, RelationFileScore, ScanRefined, score_reference};
 
 /// Mean and standard deviation of the relation errors: the JSON keys are a contract of
 /// `raypath slam --ground-truth`.

@@ -21,11 +21,11 @@
 //! "matches": [{"query", "match", "score", "correct"}]}` with file names; `ms_per_query` is the
 //! mean time to describe and score one query (plus the sequence matching with `--sequence`).
 
+use raypath_place_recognition::report::{CrossMatchReport, CrossReport};
 use raypath_place_recognition::{
     Confidence, CrossRun, CrossSummary, CrossTruth, OwnedFrame, PlaceError, PlaceRecognizer,
     ScoreMatrix, SequenceConfig, cross_summary, run_cross, sequence_match_timed,
 };
-use serde_json::json;
 
 use super::input::{Input, read_images, read_input};
 use super::{Args, WithRecognizer, dispatch};
@@ -150,7 +150,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         sequence_ms,
     };
     if crate::commands::console::json() {
-        println!("{}", report.json());
+        crate::commands::print_json(&report.json())?;
     } else {
         report.print();
     }
@@ -171,31 +171,31 @@ struct Report<'a> {
 }
 
 impl Report<'_> {
-    fn json(&self) -> serde_json::Value {
+    fn json(&self) -> CrossReport {
         let f = self.folders;
-        let matches: Vec<_> = (0..self.scores.queries())
+        let matches = (0..self.scores.queries())
             .filter_map(|q| {
                 let best = self.scores.best(q, 1).into_iter().next()?;
-                Some(json!({
-                    "query": f.query_names[q],
-                    "match": f.database_names.get(best.frame),
-                    "score": best.score,
-                    "correct": self.truth.is_match(q, best.frame),
-                }))
+                Some(CrossMatchReport {
+                    query: f.query_names[q].clone(),
+                    matched: f.database_names.get(best.frame).cloned(),
+                    score: best.score,
+                    correct: self.truth.is_match(q, best.frame),
+                })
             })
             .collect();
-        json!({
-            "method": self.method,
-            "queries": f.queries.len(),
-            "database": f.database.len(),
-            "tolerance": self.args.tolerance,
-            "sequence": self.args.sequence,
-            "ms_per_query": self.ms,
-            "sequence_ms_per_query": self.sequence_ms,
-            "summary": self.summary,
-            "single_image": self.single,
-            "matches": matches,
-        })
+        CrossReport {
+            method: self.method,
+            queries: f.queries.len(),
+            database: f.database.len(),
+            tolerance: self.args.tolerance,
+            sequence: self.args.sequence,
+            ms_per_query: self.ms,
+            sequence_ms_per_query: self.sequence_ms,
+            summary: self.summary,
+            single_image: self.single,
+            matches,
+        }
     }
 
     fn print(&self) {

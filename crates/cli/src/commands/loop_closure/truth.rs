@@ -7,27 +7,18 @@
 //! Pairing: by index (by frame number for a KITTI sequence) when the file has no times (KITTI
 //! poses) or as many poses as the input has frames (CARMEN: the laser scans); else by time —
 //! the pose at a frame's time, interpolated between the two ground-truth poses around it when
-//! they are at most [`MAX_GAP_SECS`] apart. Frames that get no pose are left out of the
+//! they are at most `raypath_io::sequence::MAX_GAP_SECS` apart (`poses_at_times`). Frames that get no pose are left out of the
 //! evaluation.
 
 use std::path::Path;
 
 use raypath_geometry::{Pose2, Pose3};
-use raypath_io::sequence::PlanarFrame;
+use raypath_io::sequence::{PlanarFrame, poses_at_times};
 use raypath_place_recognition::{Exclusion, GroundTruth};
 
 use super::super::Failure;
 use super::super::source_args::{BagSource, SourceArgs, is_bag, reference_track};
 use super::input::Input;
-
-/// Largest gap between two ground-truth poses that a frame's pose is interpolated over,
-/// seconds (ours).
-pub const MAX_GAP_SECS: f64 = 1.0;
-
-/// Largest distance between a frame time and a ground-truth time outside the ground truth's
-/// span that still pairs them (the corrected CARMEN logs print the stamps with fewer digits),
-/// seconds.
-const MATCH_TOLERANCE_SECS: f64 = 2e-3;
 
 /// Poses read from a ground-truth file.
 pub struct TruthPoses {
@@ -194,25 +185,5 @@ fn pair(truth: &TruthPoses, input: &Input) -> Vec<Option<Pose3>> {
     let (Some(truth_times), Some(frame_times)) = (&truth.times, &input.times) else {
         return vec![None; input.len()];
     };
-    let mut order: Vec<usize> = (0..truth_times.len()).collect();
-    order.sort_by(|&a, &b| truth_times[a].total_cmp(&truth_times[b]));
-    let sorted: Vec<f64> = order.iter().map(|&k| truth_times[k]).collect();
-    frame_times
-        .iter()
-        .map(|&t| {
-            let k = sorted.partition_point(|&s| s < t);
-            let near = |j: usize| (sorted[j] - t).abs() <= MATCH_TOLERANCE_SECS;
-            if k < sorted.len() && near(k) {
-                return Some(truth.poses[order[k]]);
-            }
-            if k > 0 && near(k - 1) {
-                return Some(truth.poses[order[k - 1]]);
-            }
-            if k == 0 || k == sorted.len() || sorted[k] - sorted[k - 1] > MAX_GAP_SECS {
-                return None;
-            }
-            let f = (t - sorted[k - 1]) / (sorted[k] - sorted[k - 1]);
-            Some(truth.poses[order[k - 1]].interpolate(&truth.poses[order[k]], f))
-        })
-        .collect()
+    poses_at_times(&truth.poses, truth_times, frame_times)
 }

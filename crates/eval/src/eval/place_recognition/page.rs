@@ -247,6 +247,7 @@ mod tests {
             aim: aim(name, online, "yes"),
             symmetric_aim: aim(&format!("{name} (sym)"), "yes", "yes"),
             checked_aims: Vec::new(),
+            shape_sweep: Vec::new(),
             pictures: format!("![{name}](x.png)\n\n"),
             json: json!({ "log": name }),
         }))
