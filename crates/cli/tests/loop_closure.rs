@@ -288,3 +288,33 @@ fn geometric_check_on_a_real_log() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("geometric check"));
 }
+
+#[test]
+fn scan_shapes_on_a_real_log() {
+    let Some(log) = require("carmen/corrected/csail-corrected.log.gz") else {
+        return;
+    };
+    let log = log.to_str().unwrap();
+    let run = |extra: &[&str]| {
+        let base = [
+            "loop-closure",
+            log,
+            "--method",
+            "ibuild",
+            "--ibuild-score",
+            "symmetric",
+            "--ground-truth",
+            log,
+            "--json",
+        ];
+        json_of(&raypath(&[&base[..], extra].concat()))
+    };
+    let (raster, shapes) = (run(&[]), run(&["--scan-shapes"]));
+    check_keys(&shapes, true);
+    let recall = |d: &serde_json::Value| d["summary"]["recall_at_100_precision"].as_f64().unwrap();
+    assert!(recall(&shapes) >= recall(&raster), "{shapes} vs {raster}");
+    // Only IBuILD has a scan-shape route: exit 2 naming the flag.
+    let out = raypath(&["loop-closure", log, "--method", "polar", "--scan-shapes"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--scan-shapes"));
+}

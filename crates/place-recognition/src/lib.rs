@@ -176,7 +176,8 @@ pub use features::{FeatureConfig, Keypoint, detect_and_describe};
 pub use polar::{KEY_DIM as POLAR_KEY_DIM, PolarConfig, PolarContext, PolarDescription};
 pub use raster::{RasterConfig, rasterize_scan};
 pub use shape::{
-    RINGS as SHAPE_RINGS, SECTORS as SHAPE_SECTORS, ScanShapeConfig, scan_shape_descriptors,
+    RINGS as SHAPE_RINGS, SECTORS as SHAPE_SECTORS, SHAPE_DELTA, ScanShapeConfig,
+    scan_shape_descriptors,
 };
 // --- end features ---
 

@@ -34,6 +34,11 @@ pub const RINGS: usize = 8;
 /// Sectors of the polar grid over 360°; `RINGS × SECTORS` = 512 bits.
 pub const SECTORS: usize = 64;
 
+/// IBuILD's matching threshold δ for these descriptors, bits (ours): the best of a 20–50 sweep
+/// on the corrected intel and freiburg-079 logs with the geometric check (the evaluation's δ
+/// sweep per log is in `docs/results/place-recognition.md`).
+pub const SHAPE_DELTA: u32 = 35;
+
 /// Parameters of [`scan_shape_descriptors`] (all ours: the thesis has no scan-native
 /// descriptor).
 #[derive(Clone, Debug, PartialEq)]

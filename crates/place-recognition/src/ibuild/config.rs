@@ -36,7 +36,8 @@ pub struct IbuildConfig {
     /// The similarity score of the candidates (default [`IbuildScore::Printed`], §4.4.3).
     pub score: IbuildScore,
     /// First-match search engine (identical answers; default [`VocabularySearch::Auto`]:
-    /// multi-index hashing where it is expected to be faster than the scan).
+    /// multi-index hashing where it is expected to be faster than the scan; always the scan
+    /// for [`PlanarDescriptors::Shape`], whose sparse bits defeat the hashing).
     pub search: VocabularySearch,
 }
 

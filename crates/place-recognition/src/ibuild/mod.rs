@@ -125,8 +125,15 @@ impl Ibuild {
     /// An empty IBuILD with a validated configuration.
     pub fn new(config: IbuildConfig) -> Result<Self> {
         config.validate()?;
+        // Shape descriptors are sparse (a few dozen of 512 bits set), so most of their
+        // multi-index substrings are zero and land in one bucket: hashing then verifies far more
+        // words than it skips. `Auto`'s cost model assumes dense bits (BRIEF), so it scans here.
+        let search = match (&config.planar, config.search) {
+            (PlanarDescriptors::Shape(_), VocabularySearch::Auto) => VocabularySearch::Linear,
+            (_, search) => search,
+        };
         Ok(Self {
-            vocabulary: Vocabulary::new(config.delta, config.search)?,
+            vocabulary: Vocabulary::new(config.delta, search)?,
             config,
             previous: None,
             clock: StageClock::default(),

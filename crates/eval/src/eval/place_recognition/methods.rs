@@ -257,9 +257,8 @@ fn planar_scan<'a>(
 }
 
 /// IBuILD's matching threshold δ on binary shape descriptors made on the scan (bits; ours):
-/// chosen on intel and freiburg-079 with the `shape_sweep` example of
-/// raypath-place-recognition and fixed for every log.
-pub const SHAPE_DELTA: u32 = 35;
+/// the library's choice, made on intel and freiburg-079 and fixed for every log.
+pub use raypath_place_recognition::SHAPE_DELTA;
 /// The δ sweep of the symmetric IBuILD on scan shapes (bits).
 pub const SHAPE_DELTAS: [u32; 6] = [20, 25, 30, 35, 40, 50];
 /// The label of IBuILD (printed score) on scan shapes.
