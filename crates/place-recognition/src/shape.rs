@@ -1,27 +1,6 @@
 //! Binary shape descriptors made straight on a planar scan (ours).
 //!
-//! IBuILD (Khan 2017, §4.4) describes images, so on a 2-D laser it first needs the scan as a
-//! picture ([`rasterize_scan`](crate::rasterize_scan)) and then finds FAST corners and BRIEF
-//! bits on that picture. [`scan_shape_descriptors`] skips the picture: it picks keypoints along
-//! the scan's end points and gives each a 512-bit descriptor of the shape around it:
-//!
-//! * **Outline.** The end points in beam order (returns below
-//!   [`ScanShapeConfig::max_range_m`]); two consecutive end points closer than
-//!   [`ScanShapeConfig::max_gap_m`] are joined by a segment sampled every
-//!   [`ScanShapeConfig::step_m`], so wall density does not depend on the range.
-//! * **Keypoints** every [`ScanShapeConfig::keypoint_spacing_m`] of outline length.
-//! * **Orientation.** The keypoint's local normal (the smaller principal axis of the end points
-//!   within [`ScanShapeConfig::normal_radius_m`], [`line_normal`]) turned towards the sensor, the
-//!   side the laser saw; where the neighbourhood is not line-like (a corner) the direction to
-//!   the sensor. A rotated or moved robot that sees the same wall from the same side gives the
-//!   same frame.
-//! * **Bits.** Around the keypoint, in that frame, a polar grid of [`RINGS`] rings of equal
-//!   width up to [`ScanShapeConfig::radius_m`] × [`SECTORS`] sectors: bit `ring · SECTORS +
-//!   sector` is set when an outline sample lies in the cell.
-//!
-//! Descriptors from the same place differ where keypoints fall at other places along a wall
-//! and where the two views saw different parts of the room; matching thresholds δ are
-//! therefore smaller than for BRIEF (tens of bits).
+//! See [`scan_shape_descriptors`].
 
 use nalgebra::Vector2;
 use raypath_geometry::{Range, Scan2, line_normal};
@@ -83,8 +62,31 @@ impl ScanShapeConfig {
     }
 }
 
-/// The binary shape descriptors of a planar scan (see the [module docs](self)); empty when the
-/// scan has fewer than three end points in range.
+/// The binary shape descriptors of a planar scan; empty when the scan has fewer than three end
+/// points in range.
+///
+/// IBuILD (Khan 2017, §4.4) describes images, so on a 2-D laser it first needs the scan as a
+/// picture ([`rasterize_scan`](crate::rasterize_scan)) and then finds FAST corners and BRIEF
+/// bits on that picture. [`scan_shape_descriptors`] skips the picture: it picks keypoints along
+/// the scan's end points and gives each a 512-bit descriptor of the shape around it:
+///
+/// * **Outline.** The end points in beam order (returns below
+///   [`ScanShapeConfig::max_range_m`]); two consecutive end points closer than
+///   [`ScanShapeConfig::max_gap_m`] are joined by a segment sampled every
+///   [`ScanShapeConfig::step_m`], so wall density does not depend on the range.
+/// * **Keypoints** every [`ScanShapeConfig::keypoint_spacing_m`] of outline length.
+/// * **Orientation.** The keypoint's local normal (the smaller principal axis of the end points
+///   within [`ScanShapeConfig::normal_radius_m`], [`line_normal`]) turned towards the sensor, the
+///   side the laser saw; where the neighbourhood is not line-like (a corner) the direction to
+///   the sensor. A rotated or moved robot that sees the same wall from the same side gives the
+///   same frame.
+/// * **Bits.** Around the keypoint, in that frame, a polar grid of [`RINGS`] rings of equal
+///   width up to [`ScanShapeConfig::radius_m`] × [`SECTORS`] sectors: bit `ring · SECTORS +
+///   sector` is set when an outline sample lies in the cell.
+///
+/// Descriptors from the same place differ where keypoints fall at other places along a wall
+/// and where the two views saw different parts of the room; matching thresholds δ are
+/// therefore smaller than for BRIEF (tens of bits).
 pub fn scan_shape_descriptors(scan: &Scan2, config: &ScanShapeConfig) -> Result<Vec<Bits512>> {
     config.validate()?;
     scan.validate()
