@@ -118,6 +118,16 @@ fn time_online<R: PlaceRecognizer>(
     Ok(out)
 }
 
+/// IBuILD's stage times and vocabulary size (`reset`: zero the stage times instead).
+fn ibuild_stages(m: &Ibuild, reset: bool) -> Option<(StageTimes, usize)> {
+    if reset {
+        m.reset_stage_times();
+        None
+    } else {
+        Some((m.stage_times(), m.vocabulary().len()))
+    }
+}
+
 fn ibuild_runs(scans: &[Scan2], sizes: &[usize]) -> Result<Vec<(&'static str, Vec<Window>)>> {
     // Rasterising and feature extraction once per scan (the same for both engines), timed.
     let n = scans.len().min(sizes.last().copied().unwrap_or(0));
@@ -142,14 +152,7 @@ fn ibuild_runs(scans: &[Scan2], sizes: &[usize]) -> Result<Vec<(&'static str, Ve
                 let f = &features[t];
                 Ok((m.describe_descriptors(f.descriptors.clone()), f.seconds))
             },
-            |m, reset| {
-                if reset {
-                    m.reset_stage_times();
-                    None
-                } else {
-                    Some((m.stage_times(), m.vocabulary().len()))
-                }
-            },
+            ibuild_stages,
         )?;
         out.push((label, windows));
     }
@@ -185,14 +188,7 @@ fn shape_runs(scans: &[Scan2], sizes: &[usize]) -> Result<Vec<(&'static str, Vec
     };
     let mut plain = Ibuild::new(config.clone())?;
     let describe = |t: usize, m: &mut Ibuild| Ok((m.describe(&Frame::Planar(&scans[t]))?, 0.0));
-    let plain_windows = time_online(&mut plain, scans.len(), sizes, describe, |m, reset| {
-        if reset {
-            m.reset_stage_times();
-            None
-        } else {
-            Some((m.stage_times(), m.vocabulary().len()))
-        }
-    })?;
+    let plain_windows = time_online(&mut plain, scans.len(), sizes, describe, ibuild_stages)?;
     let mut hashed = Ibuild::new(IbuildConfig {
         search: VocabularySearch::MultiIndex,
         ..config.clone()
@@ -202,14 +198,7 @@ fn shape_runs(scans: &[Scan2], sizes: &[usize]) -> Result<Vec<(&'static str, Vec
         scans.len(),
         sizes,
         |t, m| Ok((m.describe(&Frame::Planar(&scans[t]))?, 0.0)),
-        |m, reset| {
-            if reset {
-                m.reset_stage_times();
-                None
-            } else {
-                Some((m.stage_times(), m.vocabulary().len()))
-            }
-        },
+        ibuild_stages,
     )?;
     let mut checked = GeometricCheck::new(Ibuild::new(config)?, GeometricCheckConfig::default())?;
     let checked_windows = time_online(
